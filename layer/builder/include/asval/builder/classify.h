@@ -1,0 +1,65 @@
+// Classification of primitives as the spec defines it ("Inactive Primitives and Instances", "Degenerate
+// Primitives and Instances"). Decisions on the spec's open questions (docs/builder.md, "Decisions"):
+//  * inactive: raw-bit NaN test of the *source* X component (any NaN encoding), before any arithmetic;
+//    formats without NaN (SNORM/UNORM) are always active.
+//  * degenerate: tested on the decoded, untransformed components, by value (+0 == -0; SNORM codes -2^(b-1)
+//    and -2^(b-1)+1 both decode to -1 and are equal). NaN compares unequal to everything.
+//  * a NaN in the transform does not make a triangle inactive; it is counted for a warning.
+//  * NaN in Y/Z (or an AABB's non-minX component) with X not NaN: active, counted as undefined input.
+#pragma once
+
+#include <cstdint>
+
+#include "asval/builder/activity_record.h"
+#include "asval/builder/geometry_view.h"
+
+namespace asval::builder {
+
+// Per-primitive state bits (optional output, one byte per primitive; the layer normally passes none).
+enum PrimitiveState : uint8_t {
+    kStateActive = 1u << 0,
+    kStateDegenerate = 1u << 1,   // spec-degenerate (only set on active primitives)
+    kStateSameIndex = 1u << 2,    // two index values equal: always discardable (active primitives only)
+    kStateUndefined = 1u << 3,    // NaN outside X / minX while X is not NaN: behaviour undefined
+    kStateUnreadable = 1u << 4,   // its data lies outside the bytes provided: not classified (recorded active)
+    kStateInvalidAabb = 1u << 5,  // min > max on some axis (VUID-VkAabbPositionsKHR-minX-03546..03548)
+};
+
+enum class ClassifyStatus : uint8_t {
+    Ok,
+    UnsupportedFormat,     // vertexFormat not decodable: nothing classified
+    UnsupportedIndexType,  // nothing classified
+};
+
+struct ClassifyResult {
+    ClassifyStatus status = ClassifyStatus::Ok;
+    uint32_t primitiveCount = 0;
+    uint32_t active = 0;
+    uint32_t inactive = 0;
+    uint32_t degenerate = 0;
+    uint32_t sameIndex = 0;
+    uint32_t undefinedNaN = 0;
+    uint32_t unreadable = 0;
+    uint32_t invalidAabb = 0;
+    uint32_t overMaxVertex = 0;       // triangles reading a vertex above maxVertex (VUID 10774 / 10775)
+    uint32_t nullInstancePointer = 0; // arrayOfPointers entries that are null (counted unreadable too)
+    bool transformHasNaN = false;     // a NaN in the 3x4 transform (warning; activity unchanged)
+    bool transformUnreadable = false; // transform pointer set but its 48 bytes at transformOffset not provided
+    bool indexHashPartial = false;    // index bytes missing: the hash covers only what was provided
+    // First primitive of each kind, or UINT32_MAX: the layer names it in the message.
+    uint32_t firstUndefined = UINT32_MAX;
+    uint32_t firstUnreadable = UINT32_MAX;
+    uint32_t firstOverMaxVertex = UINT32_MAX;
+    uint32_t firstInvalidAabb = UINT32_MAX;
+};
+
+// Each function fills `record` (activity bits, counts, and for indexed triangles the index hash) and,
+// when `states` is not null, one PrimitiveState byte per primitive. `record` may be null to get counts only.
+// The record's storage is reused across calls when large enough.
+ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states);
+ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* record, uint8_t* states);
+// Instances: active iff accelerationStructureReference != 0. Mask 0 is active. Degenerate instances (BLAS
+// without active primitives) need the BLAS records: see build_input.h.
+ClassifyResult ClassifyInstances(const InstanceGeometryView& view, ActivityRecord* record, uint8_t* states);
+
+}  // namespace asval::builder

@@ -1,0 +1,325 @@
+// Triangle classification: the activity pass. One loop per (vertex format, index type), instantiated from
+// small traits so that the inner loop has no per-vertex switch. Hot path: no allocation except the
+// record's bitset (reused when large enough), no floating-point arithmetic before the NaN test.
+#include <algorithm>
+#include <cstring>
+#include <type_traits>
+
+#include "asval/builder/classify.h"
+#include "asval/builder/index_hash.h"
+#include "asval/builder/vertex_format.h"
+#include "format_traits.h"
+
+namespace asval::builder {
+namespace {
+
+using namespace detail;
+
+// Component keys of one vertex (see format_traits.h) plus the NaN flags of its source bits.
+struct VertexKeys {
+    uint32_t k[3];
+    bool xNaN;
+    bool yzNaN;
+};
+
+template <ComponentKind K, unsigned Bits, bool HasZ>
+struct Fmt;
+
+template <bool HasZ>
+struct Fmt<ComponentKind::Float32, 32, HasZ> {
+    static constexpr bool kHasNaN = true;
+    static VertexKeys Load(const uint8_t* p) {
+        const uint32_t x = LoadU32(p), y = LoadU32(p + 4), z = HasZ ? LoadU32(p + 8) : 0u;
+        return {{F32Key(x), F32Key(y), F32Key(z)}, F32BitsNaN(x), F32BitsNaN(y) || F32BitsNaN(z)};
+    }
+};
+
+template <bool HasZ>
+struct Fmt<ComponentKind::Float16, 16, HasZ> {
+    static constexpr bool kHasNaN = true;
+    static VertexKeys Load(const uint8_t* p) {
+        const uint32_t x = LoadU16(p), y = LoadU16(p + 2), z = HasZ ? LoadU16(p + 4) : 0u;
+        return {{F16Key(x), F16Key(y), F16Key(z)}, F16BitsNaN(x), F16BitsNaN(y) || F16BitsNaN(z)};
+    }
+};
+
+template <unsigned Bits, bool HasZ>
+struct Fmt<ComponentKind::Snorm, Bits, HasZ> {
+    static constexpr bool kHasNaN = false;
+    static int32_t Code(const uint8_t* p, int c) {
+        if constexpr (Bits == 8) return int8_t(p[c]);
+        else return int16_t(LoadU16(p + 2 * c));
+    }
+    static VertexKeys Load(const uint8_t* p) {
+        return {{SnormKey(Code(p, 0), Bits), SnormKey(Code(p, 1), Bits), HasZ ? SnormKey(Code(p, 2), Bits) : 0u},
+                false, false};
+    }
+};
+
+template <unsigned Bits, bool HasZ>
+struct Fmt<ComponentKind::Unorm, Bits, HasZ> {
+    static constexpr bool kHasNaN = false;
+    static uint32_t Code(const uint8_t* p, int c) {
+        if constexpr (Bits == 8) return p[c];
+        else return LoadU16(p + 2 * c);
+    }
+    static VertexKeys Load(const uint8_t* p) {
+        return {{Code(p, 0), Code(p, 1), HasZ ? Code(p, 2) : 0u}, false, false};
+    }
+};
+
+template <bool HasZ>
+struct Fmt<ComponentKind::Unorm1010102, 10, HasZ> {
+    static constexpr bool kHasNaN = false;
+    static VertexKeys Load(const uint8_t* p) {
+        const uint32_t w = LoadU32(p);
+        return {{w & 0x3FFu, (w >> 10) & 0x3FFu, (w >> 20) & 0x3FFu}, false, false};
+    }
+};
+
+// The spec's definition, on keys: two vertices identical, or all three sharing >= 2 of X, Y, Z.
+inline bool DegenerateKeys(const VertexKeys& a, const VertexKeys& b, const VertexKeys& c) {
+    const bool sx01 = a.k[0] == b.k[0], sy01 = a.k[1] == b.k[1], sz01 = a.k[2] == b.k[2];
+    const bool sx12 = b.k[0] == c.k[0], sy12 = b.k[1] == c.k[1], sz12 = b.k[2] == c.k[2];
+    const bool sx02 = a.k[0] == c.k[0], sy02 = a.k[1] == c.k[1], sz02 = a.k[2] == c.k[2];
+    const bool same01 = sx01 & sy01 & sz01, same12 = sx12 & sy12 & sz12, same02 = sx02 & sy02 & sz02;
+    const int axes = int(sx01 & sx12) + int(sy01 & sy12) + int(sz01 & sz12);
+    return same01 | same12 | same02 | (axes >= 2);
+}
+
+// Undefined-input triangles (NaN in Y/Z) take this path: value comparison on decoded floats, where NaN
+// is unequal to everything (IEEE ==; this file is never built with -ffast-math).
+bool DegenerateDecoded(const VertexFormatInfo& info, const uint8_t* p0, const uint8_t* p1, const uint8_t* p2) {
+    float a[3], b[3], c[3];
+    DecodeVertex(info, p0, a);
+    DecodeVertex(info, p1, b);
+    DecodeVertex(info, p2, c);
+    bool sameAB = true, sameBC = true, sameAC = true;
+    int axes = 0;
+    for (int i = 0; i < 3; ++i) {
+        sameAB &= a[i] == b[i];
+        sameBC &= b[i] == c[i];
+        sameAC &= a[i] == c[i];
+        axes += (a[i] == b[i] && b[i] == c[i]) ? 1 : 0;
+    }
+    return sameAB || sameBC || sameAC || axes >= 2;
+}
+
+struct NoIndex {};
+
+template <typename IndexT>
+inline uint64_t LoadIndex(const uint8_t* p, uint64_t i) {
+    if constexpr (sizeof(IndexT) == 1) return p[i];
+    else if constexpr (sizeof(IndexT) == 2) return LoadU16(p + 2 * i);
+    else return LoadU32(p + 4 * i);
+}
+
+struct Counters {
+    uint32_t active = 0, degenerate = 0, sameIndex = 0, undefinedNaN = 0, unreadable = 0, overMaxVertex = 0;
+    uint32_t firstUndefined = UINT32_MAX, firstUnreadable = UINT32_MAX, firstOverMaxVertex = UINT32_MAX;
+};
+
+struct LoopInput {
+    const VertexFormatInfo* info;
+    const uint8_t* vertices;
+    uint64_t readableVertices;  // vertex v is readable iff v < readableVertices (indexed: from vertexData)
+    uint64_t stride;
+    uint64_t maxVertex;
+    uint64_t firstVertex;
+    const uint8_t* indices;     // already advanced by primitiveOffset
+    uint32_t count;             // triangles
+    uint32_t readableCount;     // triangles whose indices (or vertices, non-indexed) were provided
+    uint64_t* bits;             // may be null
+    uint8_t* states;            // may be null
+};
+
+template <typename F, typename IndexT>
+void ClassifyLoop(const LoopInput& in, Counters& out) {
+    constexpr bool kIndexed = !std::is_same_v<IndexT, NoIndex>;
+    uint64_t word = 0;
+    for (uint32_t t = 0; t < in.count; ++t) {
+        uint64_t v0, v1, v2;
+        if constexpr (kIndexed) {
+            v0 = LoadIndex<IndexT>(in.indices, 3ull * t) + in.firstVertex;
+            v1 = LoadIndex<IndexT>(in.indices, 3ull * t + 1) + in.firstVertex;
+            v2 = LoadIndex<IndexT>(in.indices, 3ull * t + 2) + in.firstVertex;
+        } else {
+            v0 = 3ull * t; v1 = v0 + 1; v2 = v0 + 2;
+        }
+        const uint64_t vmax = std::max(v0, std::max(v1, v2));
+        uint8_t state;
+        if (__builtin_expect(t >= in.readableCount || vmax >= in.readableVertices, 0)) {
+            // Not provided: cannot be classified; recorded active so no update error is invented from it.
+            state = kStateActive | kStateUnreadable;
+            ++out.unreadable;
+            if (out.firstUnreadable == UINT32_MAX) out.firstUnreadable = t;
+        } else {
+            const uint8_t* p0 = in.vertices + v0 * in.stride;
+            const uint8_t* p1 = in.vertices + v1 * in.stride;
+            const uint8_t* p2 = in.vertices + v2 * in.stride;
+            const VertexKeys a = F::Load(p0), b = F::Load(p1), c = F::Load(p2);
+            const bool inactive = F::kHasNaN && (a.xNaN | b.xNaN | c.xNaN);
+            if (inactive) {
+                state = 0;
+            } else {
+                const bool undefinedInput = F::kHasNaN && (a.yzNaN | b.yzNaN | c.yzNaN);
+                bool degenerate;
+                if (__builtin_expect(undefinedInput, 0)) {
+                    degenerate = DegenerateDecoded(*in.info, p0, p1, p2);
+                    ++out.undefinedNaN;
+                    if (out.firstUndefined == UINT32_MAX) out.firstUndefined = t;
+                } else {
+                    degenerate = DegenerateKeys(a, b, c);
+                }
+                bool sameIndex = false;
+                if constexpr (kIndexed) sameIndex = (v0 == v1) | (v1 == v2) | (v0 == v2);
+                state = uint8_t(kStateActive | (degenerate ? kStateDegenerate : 0) |
+                                (sameIndex ? kStateSameIndex : 0) | (undefinedInput ? kStateUndefined : 0));
+                out.degenerate += degenerate;
+                out.sameIndex += sameIndex;
+            }
+        }
+        if (__builtin_expect(vmax > in.maxVertex, 0)) {
+            ++out.overMaxVertex;
+            if (out.firstOverMaxVertex == UINT32_MAX) out.firstOverMaxVertex = t;
+        }
+        const uint64_t activeBit = state & kStateActive;
+        out.active += uint32_t(activeBit);
+        word |= activeBit << (t & 63);
+        if ((t & 63) == 63) {
+            if (in.bits) in.bits[t >> 6] = word;
+            word = 0;
+        }
+        if (in.states) in.states[t] = state;
+    }
+    if ((in.count & 63) != 0 && in.bits) in.bits[in.count >> 6] = word;
+}
+
+using LoopFn = void (*)(const LoopInput&, Counters&);
+
+template <typename F>
+LoopFn PickIndex(int indexBytes) {
+    switch (indexBytes) {
+        case 0: return &ClassifyLoop<F, NoIndex>;
+        case 1: return &ClassifyLoop<F, uint8_t>;
+        case 2: return &ClassifyLoop<F, uint16_t>;
+        default: return &ClassifyLoop<F, uint32_t>;
+    }
+}
+
+LoopFn PickLoop(const VertexFormatInfo& f, int indexBytes) {
+    const bool z = f.componentCount >= 3;
+    switch (f.kind) {
+        case ComponentKind::Float32:
+            return z ? PickIndex<Fmt<ComponentKind::Float32, 32, true>>(indexBytes)
+                     : PickIndex<Fmt<ComponentKind::Float32, 32, false>>(indexBytes);
+        case ComponentKind::Float16:
+            return z ? PickIndex<Fmt<ComponentKind::Float16, 16, true>>(indexBytes)
+                     : PickIndex<Fmt<ComponentKind::Float16, 16, false>>(indexBytes);
+        case ComponentKind::Snorm:
+            if (f.componentBits == 8)
+                return z ? PickIndex<Fmt<ComponentKind::Snorm, 8, true>>(indexBytes)
+                         : PickIndex<Fmt<ComponentKind::Snorm, 8, false>>(indexBytes);
+            return z ? PickIndex<Fmt<ComponentKind::Snorm, 16, true>>(indexBytes)
+                     : PickIndex<Fmt<ComponentKind::Snorm, 16, false>>(indexBytes);
+        case ComponentKind::Unorm:
+            if (f.componentBits == 8)
+                return z ? PickIndex<Fmt<ComponentKind::Unorm, 8, true>>(indexBytes)
+                         : PickIndex<Fmt<ComponentKind::Unorm, 8, false>>(indexBytes);
+            return z ? PickIndex<Fmt<ComponentKind::Unorm, 16, true>>(indexBytes)
+                     : PickIndex<Fmt<ComponentKind::Unorm, 16, false>>(indexBytes);
+        case ComponentKind::Unorm1010102:
+            return PickIndex<Fmt<ComponentKind::Unorm1010102, 10, true>>(indexBytes);
+    }
+    return nullptr;
+}
+
+// Number of whole elements of `elementBytes`, `stride` apart, readable from byte `offset` of a block of
+// `bytes` (stride 0: all of them, if one is readable). Overflow-safe.
+uint64_t ReadableElements(uint64_t bytes, uint64_t offset, uint64_t elementBytes, uint64_t stride) {
+    if (offset > bytes || bytes - offset < elementBytes) return 0;
+    if (stride == 0) return UINT64_MAX;
+    return (bytes - offset - elementBytes) / stride + 1;
+}
+
+}  // namespace
+
+ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    ClassifyResult r;
+    const uint32_t n = view.range.primitiveCount;
+    r.primitiveCount = n;
+    const VertexFormatInfo* info = FindVertexFormat(view.vertexFormat);
+    if (!info) { r.status = ClassifyStatus::UnsupportedFormat; return r; }
+    const int indexBytes = IndexTypeBytes(view.indexType);
+    if (indexBytes < 0) { r.status = ClassifyStatus::UnsupportedIndexType; return r; }
+
+    if (view.transformData) {
+        const uint64_t off = view.range.transformOffset;
+        if (off > view.transformDataBytes || view.transformDataBytes - off < 48) {
+            r.transformUnreadable = true;
+        } else {
+            const auto* m = static_cast<const uint8_t*>(view.transformData) + off;
+            for (int i = 0; i < 12; ++i) r.transformHasNaN |= F32BitsNaN(LoadU32(m + 4 * i));
+        }
+    }
+
+    LoopInput in{};
+    in.info = info;
+    in.stride = view.vertexStride;
+    in.maxVertex = view.maxVertex;
+    in.count = n;
+    if (record) {
+        record->activeBits.resize((size_t(n) + 63) / 64);
+        in.bits = record->activeBits.data();
+    }
+    in.states = states;
+    const uint64_t vertexBytes = view.vertexData ? view.vertexDataBytes : 0;
+    if (indexBytes == 0) {
+        // Non-indexed: vertex j of the range sits at primitiveOffset + stride * (firstVertex + j).
+        const uint64_t base = uint64_t(view.range.primitiveOffset) + view.vertexStride * view.range.firstVertex;
+        in.vertices = static_cast<const uint8_t*>(view.vertexData) + (base <= vertexBytes ? base : 0);
+        in.readableVertices = ReadableElements(vertexBytes, base, info->vertexBytes, view.vertexStride);
+        in.readableCount = n;
+        // The loop sees vertex j of the range; it reads vertex firstVertex + j, so shift maxVertex (when
+        // firstVertex already exceeds it, 0 makes every triangle count, as vmax >= 2).
+        in.maxVertex = view.maxVertex >= view.range.firstVertex ? view.maxVertex - view.range.firstVertex : 0;
+    } else {
+        in.vertices = static_cast<const uint8_t*>(view.vertexData);
+        in.readableVertices = ReadableElements(vertexBytes, 0, info->vertexBytes, view.vertexStride);
+        in.firstVertex = view.range.firstVertex;
+        const uint64_t off = view.range.primitiveOffset;
+        const uint64_t indexAvail = view.indexData ? view.indexDataBytes : 0;
+        const uint64_t triBytes = 3ull * uint64_t(indexBytes);
+        const uint64_t readable = off <= indexAvail ? (indexAvail - off) / triBytes : 0;
+        in.readableCount = uint32_t(std::min<uint64_t>(readable, n));
+        in.indices = static_cast<const uint8_t*>(view.indexData) + (off <= indexAvail ? off : 0);
+        if (record) {
+            record->hasIndexHash = true;
+            record->indexHash = HashIndexBytes(in.indices, size_t(in.readableCount) * triBytes, uint64_t(indexBytes));
+        }
+        r.indexHashPartial = in.readableCount < n;
+    }
+    if (!in.vertices) in.readableVertices = 0;
+
+    Counters c;
+    PickLoop(*info, indexBytes)(in, c);
+
+    r.active = c.active;
+    r.inactive = n - c.active;
+    r.degenerate = c.degenerate;
+    r.sameIndex = c.sameIndex;
+    r.undefinedNaN = c.undefinedNaN;
+    r.unreadable = c.unreadable;
+    r.overMaxVertex = c.overMaxVertex;
+    r.firstUndefined = c.firstUndefined;
+    r.firstUnreadable = c.firstUnreadable;
+    r.firstOverMaxVertex = c.firstOverMaxVertex;
+    if (record) {
+        record->primitiveCount = n;
+        record->activeCount = c.active;
+        if (indexBytes == 0) { record->hasIndexHash = false; record->indexHash = {}; }
+    }
+    return r;
+}
+
+}  // namespace asval::builder

@@ -1,0 +1,94 @@
+// Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
+// Each calls down first and records only what the driver accepted.
+#include "layer_data.h"
+#include "state_tracker.h"
+#include "vk_intercepts.h"
+
+namespace asval::hooks {
+
+VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCallbacks* pAllocator) {
+  if (!device) return;
+  std::unique_ptr<DeviceData> data = Devices().Remove(GetDispatchKey(device));
+  if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL SetDebugUtilsObjectNameEXT(VkDevice device,
+                                                          const VkDebugUtilsObjectNameInfoEXT* pNameInfo) {
+  DeviceData* data = GetDeviceData(device);
+  if (!data) return VK_ERROR_INITIALIZATION_FAILED;
+  if (pNameInfo) data->reporter->SetObjectName(pNameInfo->objectHandle, pNameInfo->pObjectName);
+  if (!data->dispatch.SetDebugUtilsObjectNameEXT) return VK_SUCCESS;
+  return data->dispatch.SetDebugUtilsObjectNameEXT(device, pNameInfo);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL AllocateMemory(VkDevice device, const VkMemoryAllocateInfo* pAllocateInfo,
+                                              const VkAllocationCallbacks* pAllocator, VkDeviceMemory* pMemory) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.AllocateMemory(device, pAllocateInfo, pAllocator, pMemory);
+  if (result == VK_SUCCESS) RecordAllocateMemory(data->state, *pAllocateInfo, *pMemory);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL FreeMemory(VkDevice device, VkDeviceMemory memory, const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  if (memory) RecordFreeMemory(data->state, memory);
+  data->dispatch.FreeMemory(device, memory, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice device, const VkBufferCreateInfo* pCreateInfo,
+                                            const VkAllocationCallbacks* pAllocator, VkBuffer* pBuffer) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateBuffer(device, pCreateInfo, pAllocator, pBuffer);
+  if (result == VK_SUCCESS) RecordCreateBuffer(data->state, *pCreateInfo, *pBuffer);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice device, VkBuffer buffer, const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  if (buffer) RecordDestroyBuffer(data->state, buffer);
+  data->dispatch.DestroyBuffer(device, buffer, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BindBufferMemory(VkDevice device, VkBuffer buffer, VkDeviceMemory memory,
+                                                VkDeviceSize memoryOffset) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.BindBufferMemory(device, buffer, memory, memoryOffset);
+  if (result == VK_SUCCESS) RecordBindBufferMemory(data->state, data->dispatch, device, buffer, memory, memoryOffset);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BindBufferMemory2(VkDevice device, uint32_t bindInfoCount,
+                                                 const VkBindBufferMemoryInfo* pBindInfos) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.BindBufferMemory2(device, bindInfoCount, pBindInfos);
+  if (result == VK_SUCCESS) {
+    for (uint32_t i = 0; i < bindInfoCount; ++i) {
+      RecordBindBufferMemory(data->state, data->dispatch, device, pBindInfos[i].buffer, pBindInfos[i].memory,
+                             pBindInfos[i].memoryOffset);
+    }
+  }
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateAccelerationStructureKHR(VkDevice device,
+                                                              const VkAccelerationStructureCreateInfoKHR* pCreateInfo,
+                                                              const VkAllocationCallbacks* pAllocator,
+                                                              VkAccelerationStructureKHR* pAccelerationStructure) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result =
+      data->dispatch.CreateAccelerationStructureKHR(device, pCreateInfo, pAllocator, pAccelerationStructure);
+  if (result == VK_SUCCESS) {
+    RecordCreateAccelerationStructure(data->state, data->dispatch, device, *pCreateInfo, *pAccelerationStructure);
+  }
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
+                                                           VkAccelerationStructureKHR accelerationStructure,
+                                                           const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  if (accelerationStructure) RecordDestroyAccelerationStructure(data->state, accelerationStructure);
+  data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
+}
+
+}  // namespace asval::hooks

@@ -1,0 +1,165 @@
+// Instance-level hooks: chaining vkCreateInstance/vkCreateDevice as the loader documents, settings, the
+// reporter, and the app's debug messengers.
+#include <vulkan/vk_layer.h>
+
+#include <cstring>
+
+#include "layer_data.h"
+#include "layer_info.h"
+#include "state_tracker.h"
+#include "vk_intercepts.h"
+#include "vk_struct_chain.h"
+
+namespace asval {
+
+DispatchRegistry<InstanceData>& Instances() {
+  static DispatchRegistry<InstanceData> registry;
+  return registry;
+}
+
+DispatchRegistry<DeviceData>& Devices() {
+  static DispatchRegistry<DeviceData> registry;
+  return registry;
+}
+
+namespace {
+
+// The loader's link info for the next element of the chain (LoaderLayerInterface.md, "Layer Dispatch
+// Initialization"). The chain lives in the create info, which is const for us but is advanced in place, as
+// every layer does.
+template <typename LinkInfo, typename CreateInfo>
+LinkInfo* FindLinkInfo(const CreateInfo* create_info, VkStructureType link_type) {
+  for (auto* s = static_cast<const VkBaseInStructure*>(create_info->pNext); s; s = s->pNext) {
+    if (s->sType != link_type) continue;
+    auto* info = reinterpret_cast<LinkInfo*>(const_cast<VkBaseInStructure*>(s));
+    if (info->function == VK_LAYER_LINK_INFO) return info;
+  }
+  return nullptr;
+}
+
+ReportSettings ToReportSettings(const LayerSettings& s) {
+  ReportSettings r;
+  r.report_errors = (s.report_flags & kSeverityError) != 0;
+  r.report_warnings = (s.report_flags & kSeverityWarn) != 0;
+  r.report_info = (s.report_flags & kSeverityInfo) != 0;
+  r.duplicate_message_limit = s.duplicate_message_limit;
+  r.message_id_filter = s.message_id_filter;
+  r.report_file = s.report_file;
+  r.log_to_stderr = s.log_to_stderr;
+  return r;
+}
+
+void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, DeviceProperties* out) {
+  const InstanceDispatchTable& d = instance.dispatch;
+  if (d.GetPhysicalDeviceMemoryProperties) d.GetPhysicalDeviceMemoryProperties(gpu, &out->memory);
+  out->acceleration_structure.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
+  if (d.GetPhysicalDeviceProperties2) {
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &out->acceleration_structure, {}};
+    d.GetPhysicalDeviceProperties2(gpu, &props2);
+    out->core = props2.properties;
+  } else if (d.GetPhysicalDeviceProperties) {
+    // No properties2 (a 1.0 instance without VK_KHR_get_physical_device_properties2): the AS limits stay
+    // zero and the checks that need them count themselves as skipped.
+    d.GetPhysicalDeviceProperties(gpu, &out->core);
+  }
+  out->acceleration_structure.pNext = nullptr;
+}
+
+}  // namespace
+
+namespace hooks {
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* pCreateInfo,
+                                              const VkAllocationCallbacks* pAllocator, VkInstance* pInstance) {
+  auto* link = FindLinkInfo<VkLayerInstanceCreateInfo>(pCreateInfo, VK_STRUCTURE_TYPE_LOADER_INSTANCE_CREATE_INFO);
+  if (!link || !link->u.pLayerInfo) return VK_ERROR_INITIALIZATION_FAILED;
+  PFN_vkGetInstanceProcAddr next_gipa = link->u.pLayerInfo->pfnNextGetInstanceProcAddr;
+  auto next_create = reinterpret_cast<PFN_vkCreateInstance>(next_gipa(VK_NULL_HANDLE, "vkCreateInstance"));
+  if (!next_create) return VK_ERROR_INITIALIZATION_FAILED;
+
+  // Settings and reporter first, so that the app's create-time messengers hear about bad settings.
+  auto data = std::make_unique<InstanceData>();
+  std::vector<std::string> warnings;
+  data->settings = LoadLayerSettings(pCreateInfo->pNext, &warnings);
+  data->reporter = std::make_unique<Reporter>(ToReportSettings(data->settings));
+  for (auto* s = static_cast<const VkBaseInStructure*>(pCreateInfo->pNext); s; s = s->pNext) {
+    if (s->sType == VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT) {
+      data->reporter->AddMessenger(VK_NULL_HANDLE, *reinterpret_cast<const VkDebugUtilsMessengerCreateInfoEXT*>(s));
+    }
+  }
+  for (const std::string& w : warnings) {
+    data->reporter->Report(Severity::kWarning, "ASVAL-Settings-Invalid", Location("vkCreateInstance"), {}, w);
+  }
+
+  link->u.pLayerInfo = link->u.pLayerInfo->pNext;  // the next layer reads its own link
+  const VkResult result = next_create(pCreateInfo, pAllocator, pInstance);
+  if (result != VK_SUCCESS) return result;
+
+  data->instance = *pInstance;
+  data->next_gipa = next_gipa;
+  data->api_version = pCreateInfo->pApplicationInfo && pCreateInfo->pApplicationInfo->apiVersion
+                          ? pCreateInfo->pApplicationInfo->apiVersion
+                          : VK_API_VERSION_1_0;
+  InitInstanceDispatchTable(*pInstance, next_gipa, &data->dispatch);
+  data->reporter->RemoveCreateTimeMessengers();
+  Instances().Insert(GetDispatchKey(*pInstance), std::move(data));
+  return VK_SUCCESS;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyInstance(VkInstance instance, const VkAllocationCallbacks* pAllocator) {
+  if (!instance) return;
+  std::unique_ptr<InstanceData> data = Instances().Remove(GetDispatchKey(instance));
+  if (data && data->dispatch.DestroyInstance) data->dispatch.DestroyInstance(instance, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, const VkDeviceCreateInfo* pCreateInfo,
+                                            const VkAllocationCallbacks* pAllocator, VkDevice* pDevice) {
+  InstanceData* instance = GetInstanceData(physicalDevice);
+  auto* link = FindLinkInfo<VkLayerDeviceCreateInfo>(pCreateInfo, VK_STRUCTURE_TYPE_LOADER_DEVICE_CREATE_INFO);
+  if (!instance || !link || !link->u.pLayerInfo) return VK_ERROR_INITIALIZATION_FAILED;
+  PFN_vkGetInstanceProcAddr next_gipa = link->u.pLayerInfo->pfnNextGetInstanceProcAddr;
+  PFN_vkGetDeviceProcAddr next_gdpa = link->u.pLayerInfo->pfnNextGetDeviceProcAddr;
+  // The real instance, not NULL: some drivers and layers need it to resolve vkCreateDevice.
+  auto next_create = reinterpret_cast<PFN_vkCreateDevice>(next_gipa(instance->instance, "vkCreateDevice"));
+  if (!next_create) return VK_ERROR_INITIALIZATION_FAILED;
+
+  link->u.pLayerInfo = link->u.pLayerInfo->pNext;
+  const VkResult result = next_create(physicalDevice, pCreateInfo, pAllocator, pDevice);
+  if (result != VK_SUCCESS) return result;
+
+  auto data = std::make_unique<DeviceData>();
+  data->device = *pDevice;
+  data->physical_device = physicalDevice;
+  data->instance = instance;
+  data->reporter = instance->reporter.get();
+  data->next_gdpa = next_gdpa;
+  InitDeviceDispatchTable(*pDevice, next_gdpa, &data->dispatch);
+  data->state.features = ParseEnabledFeatures(*pCreateInfo);
+  QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
+  Devices().Insert(GetDispatchKey(*pDevice), std::move(data));
+  return VK_SUCCESS;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateDebugUtilsMessengerEXT(VkInstance instance,
+                                                            const VkDebugUtilsMessengerCreateInfoEXT* pCreateInfo,
+                                                            const VkAllocationCallbacks* pAllocator,
+                                                            VkDebugUtilsMessengerEXT* pMessenger) {
+  InstanceData* data = GetInstanceData(instance);
+  if (!data || !data->dispatch.CreateDebugUtilsMessengerEXT) return VK_ERROR_EXTENSION_NOT_PRESENT;
+  const VkResult result = data->dispatch.CreateDebugUtilsMessengerEXT(instance, pCreateInfo, pAllocator, pMessenger);
+  if (result == VK_SUCCESS) data->reporter->AddMessenger(*pMessenger, *pCreateInfo);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyDebugUtilsMessengerEXT(VkInstance instance, VkDebugUtilsMessengerEXT messenger,
+                                                         const VkAllocationCallbacks* pAllocator) {
+  InstanceData* data = GetInstanceData(instance);
+  if (!data) return;
+  if (messenger) data->reporter->RemoveMessenger(messenger);
+  if (data->dispatch.DestroyDebugUtilsMessengerEXT) {
+    data->dispatch.DestroyDebugUtilsMessengerEXT(instance, messenger, pAllocator);
+  }
+}
+
+}  // namespace hooks
+}  // namespace asval

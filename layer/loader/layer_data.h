@@ -1,0 +1,48 @@
+#pragma once
+// What the layer keeps per VkInstance and per VkDevice.
+#include <vulkan/vulkan.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "device_state.h"
+#include "dispatch_key.h"
+#include "layer_settings.h"
+#include "reporter.h"
+#include "vk_dispatch_table.h"
+
+namespace asval {
+
+struct InstanceData {
+  VkInstance instance = VK_NULL_HANDLE;
+  InstanceDispatchTable dispatch{};
+  PFN_vkGetInstanceProcAddr next_gipa = nullptr;
+  uint32_t api_version = VK_API_VERSION_1_0;
+  LayerSettings settings;
+  std::unique_ptr<Reporter> reporter;
+};
+
+struct DeviceData {
+  VkDevice device = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  InstanceData* instance = nullptr;
+  DeviceDispatchTable dispatch{};
+  PFN_vkGetDeviceProcAddr next_gdpa = nullptr;
+  Reporter* reporter = nullptr;  // the instance's
+  DeviceState state;
+};
+
+DispatchRegistry<InstanceData>& Instances();
+DispatchRegistry<DeviceData>& Devices();
+
+template <typename Handle>
+InstanceData* GetInstanceData(Handle handle) {
+  return Instances().Find(GetDispatchKey(handle));
+}
+template <typename Handle>
+DeviceData* GetDeviceData(Handle handle) {
+  return Devices().Find(GetDispatchKey(handle));
+}
+
+}  // namespace asval

@@ -1,0 +1,243 @@
+#include "reporter.h"
+
+#include <spdlog/logger.h>
+#include <spdlog/sinks/stdout_sinks.h>
+
+#include <cinttypes>
+#include <cstring>
+
+#include "json_escape.h"
+#include "vk_enum_string.h"
+#include "vuid_table.h"
+
+namespace asval {
+
+namespace {
+
+constexpr const char* kSpecUrl = "https://docs.vulkan.org/spec/latest/chapters/accelstructures.html#";
+
+std::string Hex(uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof(buf), "0x%" PRIx64, v);
+  return buf;
+}
+
+}  // namespace
+
+Reporter::Reporter(ReportSettings settings)
+    : settings_(std::move(settings)), filter_(settings_.message_id_filter) {
+  // A private logger (not in spdlog's global registry, which an app using spdlog may own).
+  stderr_logger_ = std::make_shared<spdlog::logger>("asval", std::make_shared<spdlog::sinks::stderr_sink_mt>());
+  stderr_logger_->set_pattern("asval: %v");
+  stderr_logger_->set_level(spdlog::level::trace);
+  if (!settings_.report_file.empty()) {
+    // Appended to, so that several instances in one process (or a test run) share one report.
+    json_file_ = std::fopen(settings_.report_file.c_str(), "a");
+    if (!json_file_) {
+      stderr_logger_->error("cannot open report_file '{}': {}", settings_.report_file, std::strerror(errno));
+    }
+  }
+}
+
+Reporter::~Reporter() {
+  if (json_file_) std::fclose(json_file_);
+}
+
+void Reporter::AddMessenger(VkDebugUtilsMessengerEXT handle, const VkDebugUtilsMessengerCreateInfoEXT& info) {
+  if (!info.pfnUserCallback) return;
+  std::unique_lock lock(messengers_mutex_);
+  messengers_.push_back(
+      Messenger{handle, info.messageSeverity, info.messageType, info.pfnUserCallback, info.pUserData});
+}
+
+void Reporter::RemoveMessenger(VkDebugUtilsMessengerEXT handle) {
+  std::unique_lock lock(messengers_mutex_);
+  for (size_t i = messengers_.size(); i-- > 0;) {
+    if (messengers_[i].handle == handle) messengers_.erase(messengers_.begin() + static_cast<ptrdiff_t>(i));
+  }
+}
+
+void Reporter::SetObjectName(uint64_t handle, const char* name) {
+  std::unique_lock lock(names_mutex_);
+  if (!name || !*name) {
+    names_.erase(handle);
+  } else {
+    names_[handle] = name;
+  }
+}
+
+std::string Reporter::ObjectName(uint64_t handle) const {
+  std::shared_lock lock(names_mutex_);
+  auto it = names_.find(handle);
+  return it == names_.end() ? std::string() : it->second;
+}
+
+bool Reporter::SeverityEnabled(Severity s) const {
+  switch (s) {
+    case Severity::kError: return settings_.report_errors;
+    case Severity::kWarning: return settings_.report_warnings;
+    case Severity::kInfo: break;
+  }
+  return settings_.report_info;
+}
+
+bool Reporter::CountDuplicate(uint32_t hash, bool* last) {
+  *last = false;
+  if (settings_.duplicate_message_limit == 0) return true;
+  std::lock_guard lock(duplicates_mutex_);
+  uint32_t& count = duplicate_counts_[hash];
+  if (count >= settings_.duplicate_message_limit) return false;
+  ++count;
+  *last = count == settings_.duplicate_message_limit;
+  return true;
+}
+
+bool Reporter::Report(Severity severity, std::string_view vuid_in, const Location& loc,
+                      std::initializer_list<ReportObject> objects, std::string_view message) {
+  if (!SeverityEnabled(severity)) return false;
+  const std::string_view vuid = NewestVuid(vuid_in);
+  const uint32_t hash = MessageIdHash(vuid);
+  if (filter_.Mutes(vuid, hash)) return false;
+  bool last = false;
+  if (!CountDuplicate(hash, &last)) return false;
+  (severity == Severity::kError ? error_count_ : warning_count_).fetch_add(1, std::memory_order_relaxed);
+
+  const VuidInfo* info = FindVuid(vuid);
+  const std::string_view spec_text = info ? std::string_view(info->spec_text) : std::string_view();
+  const std::string path = loc.Path();
+
+  // "Validation Error: [ VUID ] | MessageID = 0x... | vkFn(): path message" then spec text and objects.
+  std::string text;
+  text.reserve(256 + message.size() + spec_text.size());
+  text.append(SeverityHeading(severity)).append(": [ ").append(vuid).append(" ] | MessageID = ");
+  text.append(Hex(hash)).append("\n");
+  if (last) {
+    text.append("(Warning - This VUID has now been reported ")
+        .append(std::to_string(settings_.duplicate_message_limit))
+        .append(" times, which is the duplicate_message_limit value, this will be the last time reporting it).\n");
+  }
+  text.append(loc.Function()).append("(): ");
+  if (!path.empty()) text.append(path).append(" ");
+  text.append(message);
+  if (!spec_text.empty()) {
+    text.append("\nThe Vulkan spec states: ").append(spec_text).append(" (").append(kSpecUrl).append(vuid).append(")");
+  }
+
+  // Objects, with the names the app set through vkSetDebugUtilsObjectNameEXT; null handles are skipped.
+  std::vector<std::string> names;
+  std::vector<VkDebugUtilsObjectNameInfoEXT> object_infos;
+  names.reserve(objects.size());
+  object_infos.reserve(objects.size());
+  for (const ReportObject& o : objects) {
+    if (o.handle == 0) continue;
+    names.push_back(ObjectName(o.handle));
+  }
+  size_t name_index = 0;
+  for (const ReportObject& o : objects) {
+    if (o.handle == 0) continue;
+    const std::string& name = names[name_index++];
+    object_infos.push_back(VkDebugUtilsObjectNameInfoEXT{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT, nullptr,
+                                                         o.type, o.handle, name.empty() ? nullptr : name.c_str()});
+  }
+  if (!object_infos.empty()) {
+    text.append("\nObjects: ").append(std::to_string(object_infos.size()));
+    for (size_t i = 0; i < object_infos.size(); ++i) {
+      const VkDebugUtilsObjectNameInfoEXT& o = object_infos[i];
+      text.append("\n    [").append(std::to_string(i)).append("] ").append(ObjectTypeName(o.objectType));
+      text.append(" ").append(Hex(o.objectHandle));
+      if (o.pObjectName) text.append("[").append(o.pObjectName).append("]");
+    }
+  }
+
+  const std::string vuid_string(vuid);
+  VkDebugUtilsMessengerCallbackDataEXT data{};
+  data.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CALLBACK_DATA_EXT;
+  data.pMessageIdName = vuid_string.c_str();
+  data.messageIdNumber = static_cast<int32_t>(hash);
+  data.pMessage = text.c_str();
+  data.objectCount = static_cast<uint32_t>(object_infos.size());
+  data.pObjects = object_infos.data();
+
+  const VkDebugUtilsMessageSeverityFlagBitsEXT vk_severity = ToDebugUtilsSeverity(severity);
+  bool skip = false;
+  bool delivered = false;
+  {
+    // Copy the list so that no lock is held while app code runs (a callback may call Vulkan).
+    std::vector<Messenger> targets;
+    {
+      std::shared_lock lock(messengers_mutex_);
+      targets = messengers_;
+    }
+    for (const Messenger& m : targets) {
+      if (!(m.severities & vk_severity) || !(m.types & VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT)) continue;
+      delivered = true;
+      if (m.callback(vk_severity, VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT, &data, m.user_data) == VK_TRUE) {
+        skip = true;
+      }
+    }
+  }
+  if (!delivered || settings_.log_to_stderr) {
+    stderr_logger_->log(severity == Severity::kError     ? spdlog::level::err
+                        : severity == Severity::kWarning ? spdlog::level::warn
+                                                         : spdlog::level::info,
+                        text);
+  }
+  WriteJson(severity, vuid, hash, loc, objects, message, spec_text);
+  return skip;
+}
+
+void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
+                         std::initializer_list<ReportObject> objects, std::string_view message,
+                         std::string_view spec_text) {
+  if (!json_file_) return;
+  std::string line = "{\"severity\":";
+  AppendJsonString(&line, SeverityName(severity));
+  line.append(",\"vuid\":");
+  AppendJsonString(&line, vuid);
+  line.append(",\"message_id\":");
+  AppendJsonString(&line, Hex(hash));
+  line.append(",\"function\":");
+  AppendJsonString(&line, loc.Function());
+  line.append(",\"location\":");
+  AppendJsonString(&line, loc.Path());
+  line.append(",\"objects\":[");
+  bool first = true;
+  for (const ReportObject& o : objects) {
+    if (o.handle == 0) continue;
+    if (!first) line.push_back(',');
+    first = false;
+    line.append("{\"type\":");
+    AppendJsonString(&line, ObjectTypeName(o.type));
+    line.append(",\"handle\":");
+    AppendJsonString(&line, Hex(o.handle));
+    const std::string name = ObjectName(o.handle);
+    if (!name.empty()) {
+      line.append(",\"name\":");
+      AppendJsonString(&line, name);
+    }
+    line.push_back('}');
+  }
+  line.append("],\"message\":");
+  AppendJsonString(&line, message);
+  line.append(",\"spec_text\":");
+  AppendJsonString(&line, spec_text);
+  line.append("}\n");
+  std::lock_guard lock(json_mutex_);
+  std::fwrite(line.data(), 1, line.size(), json_file_);
+  std::fflush(json_file_);  // a crash of the app must not lose what was already found
+}
+
+void Reporter::LayerNotice(Severity severity, std::string_view text) {
+  stderr_logger_->log(severity == Severity::kError ? spdlog::level::err : spdlog::level::warn, text);
+  if (!json_file_) return;
+  std::string line = "{\"severity\":";
+  AppendJsonString(&line, SeverityName(severity));
+  line.append(",\"vuid\":\"ASVAL-layer-notice\",\"message\":");
+  AppendJsonString(&line, text);
+  line.append("}\n");
+  std::lock_guard lock(json_mutex_);
+  std::fwrite(line.data(), 1, line.size(), json_file_);
+  std::fflush(json_file_);
+}
+
+}  // namespace asval

@@ -1,0 +1,111 @@
+#pragma once
+// The reporter: one per VkInstance. It delivers findings to the app's VK_EXT_debug_utils messengers (calling
+// them itself, as the Khronos layer does), else to stderr, and to the JSON-lines report; it applies the
+// duplicate limit and the mute list. Everything here runs only when something is reported, never on the
+// clean hot path.
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "location.h"
+#include "message_id.h"
+#include "severity.h"
+
+namespace spdlog { class logger; }
+
+namespace asval {
+
+struct ReportSettings {
+  bool report_errors = true;
+  bool report_warnings = true;
+  bool report_info = false;
+  uint32_t duplicate_message_limit = 10;  // per VUID; 0 = unlimited
+  std::vector<std::string> message_id_filter;
+  std::string report_file;                // JSON lines; empty = none
+  bool log_to_stderr = false;             // also print when the app has a messenger
+};
+
+struct ReportObject {
+  VkObjectType type;
+  uint64_t handle;
+};
+
+template <typename Handle>
+ReportObject Obj(VkObjectType type, Handle handle) {
+  return ReportObject{type, reinterpret_cast<uint64_t>(handle)};
+}
+
+class Reporter {
+ public:
+  explicit Reporter(ReportSettings settings);
+  ~Reporter();
+  Reporter(const Reporter&) = delete;
+  Reporter& operator=(const Reporter&) = delete;
+
+  // Messengers the app created with vkCreateDebugUtilsMessengerEXT (handle) or chained into
+  // VkInstanceCreateInfo (handle VK_NULL_HANDLE; active only during vkCreateInstance/vkDestroyInstance, as the
+  // spec says, so that an app passing the same create info both ways gets each message once).
+  void AddMessenger(VkDebugUtilsMessengerEXT handle, const VkDebugUtilsMessengerCreateInfoEXT& info);
+  void RemoveMessenger(VkDebugUtilsMessengerEXT handle);
+  void RemoveCreateTimeMessengers() { RemoveMessenger(VK_NULL_HANDLE); }
+
+  void SetObjectName(uint64_t handle, const char* name);  // null or empty name forgets it
+
+  // Reports one finding. vuid may be an older spelling: the newest is reported. Returns true when a
+  // messenger callback returned VK_TRUE, i.e. the app asks the layer not to pass the call down.
+  bool Report(Severity severity, std::string_view vuid, const Location& loc,
+              std::initializer_list<ReportObject> objects, std::string_view message);
+
+  // Findings delivered so far (after filters and limits), for summaries and tests.
+  uint64_t ErrorCount() const { return error_count_.load(std::memory_order_relaxed); }
+  uint64_t WarningCount() const { return warning_count_.load(std::memory_order_relaxed); }
+
+  // A line for the layer's own problems (bad settings, internal failures): stderr and the report file.
+  void LayerNotice(Severity severity, std::string_view text);
+
+ private:
+  struct Messenger {
+    VkDebugUtilsMessengerEXT handle;
+    VkDebugUtilsMessageSeverityFlagsEXT severities;
+    VkDebugUtilsMessageTypeFlagsEXT types;
+    PFN_vkDebugUtilsMessengerCallbackEXT callback;
+    void* user_data;
+  };
+
+  bool SeverityEnabled(Severity s) const;
+  // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
+  bool CountDuplicate(uint32_t hash, bool* last);
+  std::string ObjectName(uint64_t handle) const;
+  void WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
+                 std::initializer_list<ReportObject> objects, std::string_view message, std::string_view spec_text);
+
+  const ReportSettings settings_;
+  const MessageFilter filter_;
+
+  mutable std::shared_mutex messengers_mutex_;
+  std::vector<Messenger> messengers_;
+
+  mutable std::shared_mutex names_mutex_;
+  std::unordered_map<uint64_t, std::string> names_;
+
+  std::mutex duplicates_mutex_;
+  std::unordered_map<uint32_t, uint32_t> duplicate_counts_;
+
+  std::mutex json_mutex_;
+  std::FILE* json_file_ = nullptr;
+
+  std::shared_ptr<spdlog::logger> stderr_logger_;
+  std::atomic<uint64_t> error_count_{0};
+  std::atomic<uint64_t> warning_count_{0};
+};
+
+}  // namespace asval

@@ -1,0 +1,44 @@
+#pragma once
+// Shadow records of the objects the acceleration-structure rules need. Each record is immutable once it is
+// in a map: a change (binding a buffer's memory, say) publishes a new record, so readers on other threads
+// never see a half-written object and need no lock of their own.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+
+namespace asval {
+
+struct MemoryState {
+  VkDeviceMemory handle = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  uint32_t type_index = 0;
+  VkMemoryPropertyFlags property_flags = 0;
+  VkMemoryAllocateFlags allocate_flags = 0;  // from VkMemoryAllocateFlagsInfo (DEVICE_ADDRESS_BIT matters)
+};
+
+struct BufferState {
+  VkBuffer handle = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  VkBufferUsageFlags usage = 0;
+  VkBufferCreateFlags create_flags = 0;
+  // Binding, set by vkBindBufferMemory(2); a sparse buffer is never "bound" this way.
+  bool bound = false;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize memory_offset = 0;
+  // Queried by the layer itself at bind time when the usage has SHADER_DEVICE_ADDRESS; 0 otherwise.
+  VkDeviceAddress device_address = 0;
+
+  bool Contains(VkDeviceSize offset, VkDeviceSize bytes) const { return offset <= size && bytes <= size - offset; }
+};
+
+struct AccelerationStructureState {
+  VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize offset = 0;
+  VkDeviceSize size = 0;
+  VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR;
+  VkAccelerationStructureCreateFlagsKHR create_flags = 0;
+  VkDeviceAddress device_address = 0;  // the layer queries it at creation when the device allows it
+};
+
+}  // namespace asval

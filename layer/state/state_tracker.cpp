@@ -1,0 +1,137 @@
+#include "state_tracker.h"
+
+#include "vk_dispatch_table.h"
+#include "vk_struct_chain.h"
+
+namespace asval {
+
+namespace {
+
+// VK_KHR_maintenance5's VkBufferUsageFlags2CreateInfoKHR is newer than the 1.3.239 headers. When an app chains
+// it, its 64-bit usage replaces VkBufferCreateInfo::usage, so the layer must read it to know the real usage.
+constexpr VkStructureType kBufferUsageFlags2CreateInfo = static_cast<VkStructureType>(1000470006);
+struct BufferUsageFlags2CreateInfo {
+  VkStructureType sType;
+  const void* pNext;
+  uint64_t usage;
+};
+
+}  // namespace
+
+void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
+  auto record = std::make_shared<MemoryState>();
+  record->handle = memory;
+  record->size = info.allocationSize;
+  record->type_index = info.memoryTypeIndex;
+  if (info.memoryTypeIndex < state.properties.memory.memoryTypeCount) {
+    record->property_flags = state.properties.memory.memoryTypes[info.memoryTypeIndex].propertyFlags;
+  }
+  if (auto* flags = FindInChain<VkMemoryAllocateFlagsInfo>(info.pNext, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO)) {
+    record->allocate_flags = flags->flags;
+  }
+  state.memories.insert_or_assign(memory, std::move(record));
+}
+
+void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) { state.memories.erase(memory); }
+
+void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer) {
+  auto record = std::make_shared<BufferState>();
+  record->handle = buffer;
+  record->size = info.size;
+  record->usage = info.usage;
+  if (auto* usage2 = FindInChain<BufferUsageFlags2CreateInfo>(info.pNext, kBufferUsageFlags2CreateInfo)) {
+    // Bits above 31 belong to newer extensions; the rules the layer checks use only the low ones.
+    record->usage = static_cast<VkBufferUsageFlags>(usage2->usage & 0xffffffffu);
+  }
+  record->create_flags = info.flags;
+  state.buffers.insert_or_assign(buffer, std::move(record));
+}
+
+void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer) {
+  std::optional<std::shared_ptr<const BufferState>> record = state.buffers.pop(buffer);
+  if (record && *record && (*record)->device_address != 0) {
+    state.buffer_addresses.Erase((*record)->device_address, buffer);
+  }
+}
+
+void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device, VkBuffer buffer,
+                            VkDeviceMemory memory, VkDeviceSize offset) {
+  std::optional<std::shared_ptr<const BufferState>> old = state.buffers.find(buffer);
+  if (!old || !*old) return;  // created before the layer saw the device: unknown, left alone
+  auto record = std::make_shared<BufferState>(**old);
+  record->bound = true;
+  record->memory = memory;
+  record->memory_offset = offset;
+  if ((record->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) && dispatch.GetBufferDeviceAddress) {
+    const VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, buffer};
+    record->device_address = dispatch.GetBufferDeviceAddress(device, &info);
+  }
+  if (record->device_address != 0) {
+    state.buffer_addresses.Insert(record->device_address, record->size, buffer);
+  }
+  state.buffers.insert_or_assign(buffer, std::move(record));
+}
+
+void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device,
+                                       const VkAccelerationStructureCreateInfoKHR& info,
+                                       VkAccelerationStructureKHR handle) {
+  auto record = std::make_shared<AccelerationStructureState>();
+  record->handle = handle;
+  record->buffer = info.buffer;
+  record->offset = info.offset;
+  record->size = info.size;
+  record->type = info.type;
+  record->create_flags = info.createFlags;
+  // The layer asks for the address only where the app itself could (the buffer is bound and has
+  // SHADER_DEVICE_ADDRESS usage), so that its own call breaks no rule.
+  std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(info.buffer);
+  if (buffer && *buffer && (*buffer)->bound && ((*buffer)->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) &&
+      dispatch.GetAccelerationStructureDeviceAddressKHR) {
+    const VkAccelerationStructureDeviceAddressInfoKHR address_info{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR, nullptr, handle};
+    record->device_address = dispatch.GetAccelerationStructureDeviceAddressKHR(device, &address_info);
+  }
+  state.acceleration_structures.insert_or_assign(handle, std::move(record));
+}
+
+void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
+  state.acceleration_structures.erase(handle);
+}
+
+DeviceFeatures ParseEnabledFeatures(const VkDeviceCreateInfo& info) {
+  DeviceFeatures f;
+  for (auto* s = static_cast<const VkBaseInStructure*>(info.pNext); s; s = s->pNext) {
+    switch (s->sType) {
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR: {
+        auto* as = reinterpret_cast<const VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(s);
+        f.acceleration_structure = as->accelerationStructure;
+        f.acceleration_structure_host_commands = as->accelerationStructureHostCommands;
+        f.acceleration_structure_indirect_build = as->accelerationStructureIndirectBuild;
+        f.acceleration_structure_capture_replay = as->accelerationStructureCaptureReplay;
+        break;
+      }
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES:
+        f.buffer_device_address |= reinterpret_cast<const VkPhysicalDeviceBufferDeviceAddressFeatures*>(s)->bufferDeviceAddress;
+        break;
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES_EXT:
+        f.buffer_device_address |=
+            reinterpret_cast<const VkPhysicalDeviceBufferDeviceAddressFeaturesEXT*>(s)->bufferDeviceAddress;
+        break;
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES:
+        f.buffer_device_address |= reinterpret_cast<const VkPhysicalDeviceVulkan12Features*>(s)->bufferDeviceAddress;
+        break;
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR:
+        f.ray_query = reinterpret_cast<const VkPhysicalDeviceRayQueryFeaturesKHR*>(s)->rayQuery;
+        break;
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR:
+        f.ray_tracing_pipeline =
+            reinterpret_cast<const VkPhysicalDeviceRayTracingPipelineFeaturesKHR*>(s)->rayTracingPipeline;
+        break;
+      default:
+        break;
+    }
+  }
+  return f;
+}
+
+}  // namespace asval
