@@ -79,6 +79,14 @@ bool ApiStrings(const VkLayerSettingEXT& entry, std::vector<std::string>* out, s
     return true;
 }
 
+// The first string of a STRING entry; fails when it is NULL.
+bool ApiSingleString(const VkLayerSettingEXT& entry, std::string* out, std::string* error) {
+    const char* text = *static_cast<const char* const*>(entry.pValues);
+    if (text == nullptr) return Fail(error, "has a NULL string at pValues[0]");
+    *out = text;
+    return true;
+}
+
 }  // namespace
 
 std::string DescribeApiEntryProblem(const VkLayerSettingEXT& entry) {
@@ -100,7 +108,11 @@ bool ReadBool(const RawSetting& raw, bool* out, std::string* error) {
     }
     const VkLayerSettingEXT& entry = *raw.api;
     if (!CheckSingleValue(entry, error)) return false;
-    if (entry.type != VK_LAYER_SETTING_TYPE_BOOL32_EXT) return WrongType(entry, TypeName(VK_LAYER_SETTING_TYPE_BOOL32_EXT), error);
+    if (entry.type == VK_LAYER_SETTING_TYPE_STRING_EXT) {
+        RawSetting text;
+        return ApiSingleString(entry, &text.text, error) && ReadBool(text, out, error);
+    }
+    if (entry.type != VK_LAYER_SETTING_TYPE_BOOL32_EXT) return WrongType(entry, "a BOOL32 (or STRING) value", error);
     const VkBool32 value = *static_cast<const VkBool32*>(entry.pValues);
     if (value != VK_TRUE && value != VK_FALSE) {
         return Fail(error, "has VkBool32 value " + std::to_string(value) + ", neither VK_TRUE nor VK_FALSE");
@@ -112,6 +124,11 @@ bool ReadBool(const RawSetting& raw, bool* out, std::string* error) {
 bool ReadInteger(const RawSetting& raw, int64_t min, int64_t max, int64_t* out, std::string* error) {
     std::optional<int64_t> value;
     std::string shown;
+    if (raw.api != nullptr && raw.api->type == VK_LAYER_SETTING_TYPE_STRING_EXT) {
+        RawSetting text;
+        return CheckSingleValue(*raw.api, error) && ApiSingleString(*raw.api, &text.text, error) &&
+               ReadInteger(text, min, max, out, error);
+    }
     if (raw.api == nullptr) {
         value = ParseInteger(raw.text);
         if (!value) return Fail(error, "'" + raw.text + "' is not an integer (decimal or 0x hexadecimal)");
@@ -119,7 +136,7 @@ bool ReadInteger(const RawSetting& raw, int64_t min, int64_t max, int64_t* out, 
     } else {
         const VkLayerSettingEXT& entry = *raw.api;
         if (!CheckSingleValue(entry, error)) return false;
-        if (!IsIntegerType(entry.type)) return WrongType(entry, "an INT32, UINT32, INT64 or UINT64 value", error);
+        if (!IsIntegerType(entry.type)) return WrongType(entry, "an INT32, UINT32, INT64, UINT64 (or STRING) value", error);
         value = IntegerValue(entry, 0);
         shown = UnsignedText(entry, 0);
     }
@@ -137,11 +154,8 @@ bool ReadString(const RawSetting& raw, std::string* out, std::string* error) {
     }
     const VkLayerSettingEXT& entry = *raw.api;
     if (!CheckSingleValue(entry, error)) return false;
-    if (entry.type != VK_LAYER_SETTING_TYPE_STRING_EXT) return WrongType(entry, TypeName(VK_LAYER_SETTING_TYPE_STRING_EXT), error);
-    std::vector<std::string> strings;
-    if (!ApiStrings(entry, &strings, error)) return false;
-    *out = std::move(strings.front());
-    return true;
+    if (entry.type != VK_LAYER_SETTING_TYPE_STRING_EXT) return WrongType(entry, "a STRING value", error);
+    return ApiSingleString(entry, out, error);
 }
 
 bool ReadList(const RawSetting& raw, std::vector<std::string>* out, std::string* error) {

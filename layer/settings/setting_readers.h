@@ -8,6 +8,8 @@
 //   LIST          STRING (each value one item, verbatim), or INT32/UINT32/INT64/UINT64 written in
 //                 decimal, as VUL converts them for string lists
 //   FLAGS         STRING, each value one flag name
+// Beyond VUL (which rejects a type mismatch), BOOL and INT also take one STRING value parsed like
+// text, so an application can pass every setting as a string, as it would write it in the file.
 // Text values: BOOL and INT per setting_text.h; STRING verbatim (never split: it may be a path with
 // ':'); LIST and FLAGS split per SplitList.
 #pragma once

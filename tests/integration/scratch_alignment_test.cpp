@@ -17,7 +17,7 @@ TEST_CASE("03710: a misaligned scratch address is reported", "[integration][0371
   build.UseScratchOffset(alignment / 2);
   f.monitor().Expect(kVuid);
   device.OneShot([&](VkCommandBuffer cb) { build.Record(device, cb); });
-  CHECK(f.monitor().Verify().empty());
+  CHECK(f.monitor().Verify() == "");
   build.Release(device);
 }
 
@@ -55,7 +55,7 @@ TEST_CASE("03710 valid twin: aligned scratch addresses stay silent", "[integrati
     build.UseScratchOffset(offset);
     device.OneShot([&](VkCommandBuffer cb) { build.Record(device, cb); });
     INFO("scratch offset " << offset);
-    CHECK(f.monitor().Verify().empty());
+    CHECK(f.monitor().Verify() == "");
   }
   build.Release(device);
 }

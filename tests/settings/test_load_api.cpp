@@ -47,6 +47,13 @@ TEST_CASE("API values of each accepted type", "[settings][api]") {
     CHECK(LoadOne(Entry("report_file", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &path), &warnings).report_file ==
           "/tmp/report:1.jsonl");
 
+    // BOOL and INT settings also take one string, parsed like a settings-file value.
+    const char* on = "on";
+    const char* hex = "0x11";
+    CHECK(LoadOne(Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &on), &warnings).log_to_stderr);
+    CHECK(LoadOne(Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &hex), &warnings)
+              .duplicate_message_limit == 17);
+
     const char* flags[] = {"warn", "info"};
     CHECK(LoadOne(Entry("report_flags", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, flags), &warnings).report_flags ==
           (kSeverityWarn | kSeverityInfo));
@@ -69,7 +76,6 @@ TEST_CASE("API values of a wrong type give a warning and keep the default", "[se
     const double f64 = 1.0;
     const VkBool32 yes = VK_TRUE;
     const uint32_t one = 1;
-    const char* text = "true";
     struct Case {
         VkLayerSettingEXT entry;
         const char* expect;
@@ -78,7 +84,6 @@ TEST_CASE("API values of a wrong type give a warning and keep the default", "[se
              Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_FLOAT32_EXT, 1, &f32), "VK_LAYER_SETTING_TYPE_FLOAT32_EXT"},
              Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &yes), "VK_LAYER_SETTING_TYPE_BOOL32_EXT"},
              Case{Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_FLOAT64_EXT, 1, &f64), "VK_LAYER_SETTING_TYPE_FLOAT64_EXT"},
-             Case{Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &text), "VK_LAYER_SETTING_TYPE_STRING_EXT"},
              Case{Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &one), "VK_LAYER_SETTING_TYPE_UINT32_EXT"},
              Case{Entry("report_file", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &one), "VK_LAYER_SETTING_TYPE_UINT32_EXT"},
              Case{Entry("report_flags", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &one), "VK_LAYER_SETTING_TYPE_UINT32_EXT"},
@@ -99,6 +104,9 @@ TEST_CASE("malformed API entries give a warning and are ignored", "[settings][ap
     const int32_t negative = -1;
     const uint64_t huge = 1ull << 40;
     const char* null_string[] = {"error", nullptr};
+    const char* maybe = "maybe";
+    const char* many = "many";
+    const char* minus = "-3";
     struct Case {
         VkLayerSettingEXT entry;
         const char* expect;
@@ -114,6 +122,12 @@ TEST_CASE("malformed API entries give a warning and are ignored", "[settings][ap
              Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_UINT64_EXT, 1, &huge),
                   "1099511627776 is outside the range"},
              Case{Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &not_a_bool), "neither VK_TRUE nor VK_FALSE"},
+             Case{Entry("log_to_stderr", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &maybe), "'maybe' is not a boolean"},
+             Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &many), "'many' is not an integer"},
+             Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &minus), "-3 is outside the range"},
+             Case{Entry("duplicate_message_limit", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, null_string),
+                  "valueCount 2; this setting takes one value"},
+             Case{Entry("report_file", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &null_string[1]), "NULL string at pValues[0]"},
              Case{Entry("report_flags", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, null_string), "NULL string at pValues[1]"},
              Case{Entry("message_id_filter", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, null_string), "NULL string at pValues[1]"},
              Case{Entry("message_id_filter", VK_LAYER_SETTING_TYPE_STRING_EXT, 0, nullptr), "valueCount 0"},

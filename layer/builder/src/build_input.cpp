@@ -1,0 +1,175 @@
+// Conservative primitive boxes for the BVH (see build_input.h).
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "asval/builder/build_input.h"
+#include "asval/builder/classify.h"
+#include "asval/builder/vertex_format.h"
+#include "conservative_bounds.h"
+#include "format_traits.h"
+
+namespace asval::builder {
+namespace {
+
+// The exact decoded value of a norm component is c / K, which the float decode rounds. Returns the float
+// interval [lo, hi] that holds the exact value (equal bounds when the float is exact).
+void NormInterval(float f, uint32_t k, int32_t code, float* lo, float* hi) {
+    const double back = double(f) * double(k);  // exact: 24-bit times <= 16-bit
+    *lo = *hi = f;
+    if (back < double(code)) *hi = std::nextafter(f, INFINITY);
+    else if (back > double(code)) *lo = std::nextafter(f, -INFINITY);
+}
+
+// Exact-value interval of each decoded component of one vertex.
+void VertexInterval(const VertexFormatInfo& info, const uint8_t* p, float lo[3], float hi[3]) {
+    float xyz[3];
+    DecodeVertex(info, p, xyz);
+    for (int c = 0; c < 3; ++c) lo[c] = hi[c] = xyz[c];
+    if (info.kind != ComponentKind::Snorm && info.kind != ComponentKind::Unorm &&
+        info.kind != ComponentKind::Unorm1010102)
+        return;  // float formats decode exactly
+    for (int c = 0; c < 3; ++c) {
+        if (c >= info.componentCount && info.kind != ComponentKind::Unorm1010102) continue;  // Z = 0 exactly
+        int32_t code;
+        uint32_t k;
+        if (info.kind == ComponentKind::Unorm1010102) {
+            code = int32_t((detail::LoadU32(p) >> (10 * c)) & 0x3FFu);
+            k = 1023;
+        } else if (info.kind == ComponentKind::Unorm) {
+            code = int32_t(info.componentBits == 8 ? p[c] : detail::LoadU16(p + 2 * c));
+            k = (1u << info.componentBits) - 1;
+        } else {
+            code = info.componentBits == 8 ? int32_t(int8_t(p[c])) : int32_t(int16_t(detail::LoadU16(p + 2 * c)));
+            k = (1u << (info.componentBits - 1)) - 1;
+            if (code < -int32_t(k)) code = -int32_t(k);
+        }
+        NormInterval(xyz[c], k, code, &lo[c], &hi[c]);
+    }
+}
+
+void Put(BuildInput* out, uint32_t id, const float lo[3], const float hi[3]) {
+    PrimRef r;
+    bool infinite = false;
+    for (int c = 0; c < 3; ++c) {
+        r.lo[c] = lo[c];
+        r.hi[c] = hi[c];
+        infinite |= std::isinf(lo[c]) || std::isinf(hi[c]);
+    }
+    r.id = id;
+    r.aux = 0;
+    out->infiniteBoxes += infinite;
+    out->refs.push_back(r);
+}
+
+// Sorts a primitive's classification into "kept" or one of the exclusion counters.
+bool Keep(uint8_t s, bool allowUpdate, BuildInput* out) {
+    if (s & kStateUnreadable) { ++out->excludedUnreadable; return false; }
+    if (!(s & kStateActive)) { ++out->excludedInactive; return false; }
+    if (s & kStateUndefined) { ++out->excludedUndefined; return false; }
+    if (s & kStateInvalidAabb) { ++out->excludedInvalid; return false; }
+    if (s & kStateSameIndex) { ++out->excludedSameIndex; return false; }
+    if ((s & kStateDegenerate) && !allowUpdate) { ++out->excludedDegenerate; return false; }
+    return true;
+}
+
+}  // namespace
+
+void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    const uint32_t n = view.range.primitiveCount;
+    std::vector<uint8_t> states(n);
+    const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());
+    if (cr.status != ClassifyStatus::Ok) { out->excludedUnreadable += n; return; }
+    const VertexFormatInfo& info = *FindVertexFormat(view.vertexFormat);
+    const int indexBytes = IndexTypeBytes(view.indexType);
+    float m[12];
+    const bool transformed = view.transformData && !cr.transformUnreadable;
+    if (transformed)
+        std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
+    const auto* vb = static_cast<const uint8_t*>(view.vertexData);
+    const auto* ib = static_cast<const uint8_t*>(view.indexData) + (indexBytes ? view.range.primitiveOffset : 0);
+    const uint64_t nonIndexedBase = uint64_t(view.range.primitiveOffset) + view.vertexStride * view.range.firstVertex;
+    out->refs.reserve(out->refs.size() + n);
+    for (uint32_t t = 0; t < n; ++t) {
+        if (!Keep(states[t], allowUpdate, out)) continue;
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int k = 0; k < 3; ++k) {
+            uint64_t off;
+            if (indexBytes == 0) {
+                off = nonIndexedBase + (3ull * t + uint64_t(k)) * view.vertexStride;
+            } else {
+                const uint8_t* ip = ib + (3ull * t + uint64_t(k)) * uint64_t(indexBytes);
+                const uint64_t idx = indexBytes == 1 ? ip[0] : indexBytes == 2 ? detail::LoadU16(ip) : detail::LoadU32(ip);
+                off = (idx + view.range.firstVertex) * view.vertexStride;  // readable: the classifier checked
+            }
+            float vlo[3], vhi[3];
+            VertexInterval(info, vb + off, vlo, vhi);
+            if (transformed) {
+                float tlo[3], thi[3];
+                TransformBoxConservative(m, vlo, vhi, tlo, thi);
+                std::memcpy(vlo, tlo, sizeof vlo);
+                std::memcpy(vhi, thi, sizeof vhi);
+            }
+            for (int c = 0; c < 3; ++c) {
+                lo[c] = vlo[c] < lo[c] ? vlo[c] : lo[c];
+                hi[c] = vhi[c] > hi[c] ? vhi[c] : hi[c];
+            }
+        }
+        Put(out, idBase + t, lo, hi);
+    }
+}
+
+void AppendAabbs(const AabbGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    const uint32_t n = view.range.primitiveCount;
+    std::vector<uint8_t> states(n);
+    ClassifyAabbs(view, nullptr, states.data());
+    out->refs.reserve(out->refs.size() + n);
+    // Degenerate AABBs (points) "may invoke the intersection shader": kept regardless of allowUpdate.
+    (void)allowUpdate;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!Keep(uint8_t(states[i] & ~kStateDegenerate), true, out)) continue;
+        const uint8_t* p = static_cast<const uint8_t*>(view.data) + view.range.primitiveOffset + uint64_t(i) * view.stride;
+        float b[6];
+        std::memcpy(b, p, sizeof b);
+        Put(out, idBase + i, b, b + 3);
+    }
+}
+
+void AppendInstances(const InstanceGeometryView& view, BlasLookup lookup, void* user, uint32_t idBase,
+                     BuildInput* out) {
+    const uint32_t n = view.range.primitiveCount;
+    std::vector<uint8_t> states(n);
+    ClassifyInstances(view, nullptr, states.data());
+    out->refs.reserve(out->refs.size() + n);
+    const uint64_t elem = view.arrayOfPointers ? sizeof(const void*) : 64;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!Keep(states[i], true, out)) continue;
+        const uint8_t* inst = static_cast<const uint8_t*>(view.data) + view.range.primitiveOffset + uint64_t(i) * elem;
+        if (view.arrayOfPointers) {
+            const void* ptr;
+            std::memcpy(&ptr, inst, sizeof ptr);
+            inst = static_cast<const uint8_t*>(ptr);
+        }
+        float m[12];
+        uint64_t reference;
+        std::memcpy(m, inst, sizeof m);
+        std::memcpy(&reference, inst + 56, 8);
+        const BlasSummary blas = lookup ? lookup(reference, user) : BlasSummary{};
+        if (!blas.known) { ++out->excludedInvalid; continue; }
+        float lo[3], hi[3];
+        if (blas.activePrimitives == 0) {
+            // Degenerate instance: "a point at the instance origin, specified by transform".
+            for (int r = 0; r < 3; ++r) {
+                const float t = m[4 * r + 3];
+                lo[r] = std::isnan(t) ? -INFINITY : t;
+                hi[r] = std::isnan(t) ? INFINITY : t;
+            }
+            ++out->degenerateInstances;
+        } else {
+            TransformBoxConservative(m, blas.lo, blas.hi, lo, hi);
+        }
+        Put(out, idBase + i, lo, hi);
+    }
+}
+
+}  // namespace asval::builder

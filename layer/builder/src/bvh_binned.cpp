@@ -1,0 +1,309 @@
+// Binned SAH builder (default mode). Top-down; each node bins reference centroids on all three axes,
+// sweeps the bins for the cheapest SAH split and partitions in place. Subtrees above kSpawnRefs become
+// tasks that any thread may run; each task writes its own node array and the arrays are stitched in a
+// fixed order, so the tree is identical for every thread count.
+#include <emmintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "bvh_internal.h"
+
+namespace asval::builder::detail {
+namespace {
+
+constexpr uint32_t kSpawnRefs = 4096;
+constexpr uint32_t kMaxBins = 64;
+
+struct Range {
+    uint32_t begin, end;
+    __m128 lo, hi;    // box of the references
+    __m128 clo, chi;  // box of their centroids
+    uint32_t depth;   // 1 for the root
+};
+
+struct Task {
+    Range range;
+    std::vector<BvhNode> nodes;  // nodes[0] is this task's root
+    // Subtrees handed to other tasks: (slot in `nodes` that will hold that task's root, the task).
+    std::vector<std::pair<uint32_t, std::unique_ptr<Task>>> children;
+};
+
+class Queue {
+public:
+    void Push(Task* t) {
+        { std::lock_guard<std::mutex> l(mutex_); queue_.push_back(t); ++pending_; }
+        cv_.notify_one();
+    }
+    // Runs tasks until every pushed task (and those they push) has finished.
+    template <typename Fn>
+    void Work(Fn&& run) {
+        std::unique_lock<std::mutex> l(mutex_);
+        for (;;) {
+            if (!queue_.empty()) {
+                Task* t = queue_.front();
+                queue_.pop_front();
+                l.unlock();
+                run(t);
+                l.lock();
+                if (--pending_ == 0) cv_.notify_all();
+            } else if (pending_ == 0) {
+                return;
+            } else {
+                cv_.wait(l);
+            }
+        }
+    }
+
+private:
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    std::deque<Task*> queue_;
+    uint32_t pending_ = 0;
+};
+
+struct Bin {
+    __m128 lo, hi;
+};
+
+class BinnedBuilder {
+public:
+    BinnedBuilder(PrimRef* refs, const BuildOptions& o, Queue* q)
+        : refs_(refs), bins_(std::clamp<uint32_t>(o.bins, 2, kMaxBins)),
+          maxLeaf_(std::clamp<uint32_t>(o.maxLeafSize, 1, 8)), queue_(q) {}
+
+    void RunTask(Task* task) {
+        task->nodes.emplace_back();
+        Build(task, 0, task->range);
+    }
+
+private:
+    PrimRef* refs_;
+    uint32_t bins_;
+    uint32_t maxLeaf_;
+    Queue* queue_;
+
+    void MakeLeaf(Task* task, uint32_t slot, const Range& r) {
+        BvhNode& n = task->nodes[slot];
+        StoreNodeBox(n, r.lo, r.hi);
+        n.leftOrFirst = r.begin;
+        n.count = r.end - r.begin;
+    }
+
+    // Box and centroid box of refs[b, e).
+    void Measure(uint32_t b, uint32_t e, Range* r) const {
+        __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+        __m128 clo = lo, chi = hi;
+        for (uint32_t i = b; i < e; ++i) {
+            lo = _mm_min_ps(lo, LoadLo(refs_[i]));
+            hi = _mm_max_ps(hi, LoadHi(refs_[i]));
+            const __m128 c = Centroid(refs_[i]);
+            clo = _mm_min_ps(clo, c);
+            chi = _mm_max_ps(chi, c);
+        }
+        r->begin = b; r->end = e; r->lo = lo; r->hi = hi; r->clo = clo; r->chi = chi;
+    }
+
+    void Build(Task* task, uint32_t slot, Range r) {
+        const uint32_t count = r.end - r.begin;
+        if (count == 1) { MakeLeaf(task, slot, r); return; }
+
+        alignas(16) float clo[4], chi[4];
+        _mm_store_ps(clo, r.clo);
+        _mm_store_ps(chi, r.chi);
+        const bool forceMedian = r.depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth;
+
+        int axis = -1;
+        uint32_t splitBin = 0;
+        double bestCost = INFINITY;
+        __m128 P, Q, CminP;
+        if (!forceMedian) {
+            // Bin coordinate t = (c * p - cmin * p) * q, p a power of two keeping tiny (subnormal) and
+            // huge extents in range; garbage lanes clamp into [0, bins) and only cost quality.
+            alignas(16) float p[4] = {1, 1, 1, 1}, q[4] = {0, 0, 0, 0}, cminp[4] = {0, 0, 0, 0};
+            for (int a = 0; a < 3; ++a) {
+                const double extent = double(chi[a]) - double(clo[a]);
+                if (!(extent > 0)) continue;
+                p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
+                q[a] = float(double(bins_) * (1 - 1e-6) / (extent * double(p[a])));
+                cminp[a] = clo[a] * p[a];
+            }
+            P = _mm_load_ps(p); Q = _mm_load_ps(q); CminP = _mm_load_ps(cminp);
+            const __m128 maxBin = _mm_set1_ps(float(bins_ - 1)), zero = _mm_setzero_ps();
+
+            Bin bins[3][kMaxBins];
+            uint32_t counts[3][kMaxBins] = {};
+            for (int a = 0; a < 3; ++a)
+                for (uint32_t k = 0; k < bins_; ++k) bins[a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+            for (uint32_t i = r.begin; i < r.end; ++i) {
+                const PrimRef& ref = refs_[i];
+                const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(ref), P), CminP), Q);
+                alignas(16) int32_t k[4];
+                _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, zero), maxBin)));
+                const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
+                for (int a = 0; a < 3; ++a) {
+                    Bin& b = bins[a][k[a]];
+                    b.lo = _mm_min_ps(b.lo, lo);
+                    b.hi = _mm_max_ps(b.hi, hi);
+                    ++counts[a][k[a]];
+                }
+            }
+            // Sweep: right-to-left prefix areas, then left-to-right cost.
+            for (int a = 0; a < 3; ++a) {
+                if (q[a] == 0) continue;
+                double rightArea[kMaxBins];
+                uint32_t rightCount[kMaxBins];
+                __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+                uint32_t n = 0;
+                for (uint32_t k = bins_ - 1; k > 0; --k) {
+                    lo = _mm_min_ps(lo, bins[a][k].lo);
+                    hi = _mm_max_ps(hi, bins[a][k].hi);
+                    n += counts[a][k];
+                    rightArea[k] = n ? HalfArea(lo, hi) : 0.0;
+                    rightCount[k] = n;
+                }
+                lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
+                n = 0;
+                for (uint32_t k = 0; k + 1 < bins_; ++k) {
+                    lo = _mm_min_ps(lo, bins[a][k].lo);
+                    hi = _mm_max_ps(hi, bins[a][k].hi);
+                    n += counts[a][k];
+                    if (n == 0 || rightCount[k + 1] == 0) continue;
+                    const double cost = HalfArea(lo, hi) * n + rightArea[k + 1] * rightCount[k + 1];
+                    if (cost < bestCost) { bestCost = cost; axis = a; splitBin = k + 1; }
+                }
+            }
+            if (count <= maxLeaf_) {
+                const double nodeArea = HalfArea(r.lo, r.hi);
+                if (axis < 0 || !(nodeArea + bestCost < nodeArea * count)) { MakeLeaf(task, slot, r); return; }
+            }
+        }
+
+        Range left, right;
+        if (axis >= 0) {
+            // Partition by bin on `axis`, tracking both sides' boxes and centroid boxes.
+            const float pa = _mm_cvtss_f32(_mm_shuffle_ps(P, P, axis == 0 ? 0 : axis == 1 ? 0x55 : 0xAA));
+            alignas(16) float qv[4], cv[4];
+            _mm_store_ps(qv, Q);
+            _mm_store_ps(cv, CminP);
+            auto binOf = [&](const PrimRef& ref) {
+                alignas(16) float c[4];
+                _mm_store_ps(c, Centroid(ref));
+                float t = (c[axis] * pa - cv[axis]) * qv[axis];
+                t = t > 0 ? t : 0;  // NaN -> 0, as in the binning pass
+                t = t < float(bins_ - 1) ? t : float(bins_ - 1);
+                return uint32_t(t);
+            };
+            uint32_t i = r.begin, j = r.end;
+            while (i < j) {
+                if (binOf(refs_[i]) < splitBin) { ++i; continue; }
+                --j;
+                std::swap(refs_[i], refs_[j]);
+            }
+            Measure(r.begin, i, &left);
+            Measure(i, r.end, &right);
+        } else {
+            // No usable SAH split (identical centroids, depth budget): halve; by centroid when they differ.
+            int wide = 0;
+            for (int a = 1; a < 3; ++a)
+                if (double(chi[a]) - double(clo[a]) > double(chi[wide]) - double(clo[wide])) wide = a;
+            const uint32_t mid = r.begin + count / 2;
+            if (chi[wide] > clo[wide]) {
+                std::nth_element(refs_ + r.begin, refs_ + mid, refs_ + r.end, [wide](const PrimRef& x, const PrimRef& y) {
+                    alignas(16) float cx[4], cy[4];
+                    _mm_store_ps(cx, Centroid(x));
+                    _mm_store_ps(cy, Centroid(y));
+                    return cx[wide] < cy[wide] || (cx[wide] == cy[wide] && x.id < y.id);
+                });
+            }
+            Measure(r.begin, mid, &left);
+            Measure(mid, r.end, &right);
+        }
+        left.depth = right.depth = r.depth + 1;
+
+        const uint32_t childSlot = uint32_t(task->nodes.size());
+        task->nodes.emplace_back();
+        task->nodes.emplace_back();
+        BvhNode& n = task->nodes[slot];
+        StoreNodeBox(n, r.lo, r.hi);
+        n.leftOrFirst = childSlot;
+        n.count = 0;
+        if (right.end - right.begin >= kSpawnRefs) {
+            auto child = std::make_unique<Task>();
+            child->range = right;
+            Task* raw = child.get();
+            task->children.emplace_back(childSlot + 1, std::move(child));
+            queue_->Push(raw);
+            Build(task, childSlot, left);
+        } else {
+            Build(task, childSlot, left);
+            Build(task, childSlot + 1, right);
+        }
+    }
+};
+
+// Appends `task`'s nodes to `out`, its root going to out[rootSlot]; then its child tasks, in order.
+void Stitch(Task& task, uint32_t rootSlot, std::vector<BvhNode>& out) {
+    const uint32_t base = uint32_t(out.size());
+    auto remap = [base](uint32_t local) { return base + local - 1; };  // local 0 is the root
+    auto fix = [&](BvhNode n) {
+        if (n.count == 0) n.leftOrFirst = remap(n.leftOrFirst);
+        return n;
+    };
+    out.resize(out.size() + task.nodes.size() - 1);
+    for (size_t i = 1; i < task.nodes.size(); ++i) out[remap(uint32_t(i))] = fix(task.nodes[i]);
+    out[rootSlot] = fix(task.nodes[0]);
+    std::vector<BvhNode>().swap(task.nodes);
+    for (auto& [slot, child] : task.children) Stitch(*child, remap(slot), out);
+}
+
+size_t CountNodes(const Task& t) {
+    size_t n = t.nodes.size() - 1;
+    for (const auto& c : t.children) n += CountNodes(*c.second);
+    return n;
+}
+
+}  // namespace
+
+Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
+    Bvh bvh;
+    if (refs.empty()) return bvh;
+    Queue queue;
+    BinnedBuilder builder(refs.data(), options, &queue);
+    Task root;
+    {
+        Range r{};
+        __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY), clo = lo, chi = hi;
+        for (const PrimRef& ref : refs) {
+            lo = _mm_min_ps(lo, LoadLo(ref));
+            hi = _mm_max_ps(hi, LoadHi(ref));
+            const __m128 c = Centroid(ref);
+            clo = _mm_min_ps(clo, c);
+            chi = _mm_max_ps(chi, c);
+        }
+        r.begin = 0; r.end = uint32_t(refs.size());
+        r.lo = lo; r.hi = hi; r.clo = clo; r.chi = chi; r.depth = 1;
+        root.range = r;
+    }
+    queue.Push(&root);
+    auto run = [&builder](Task* t) { builder.RunTask(t); };
+    std::vector<std::thread> workers;
+    for (uint32_t i = 1; i < std::max<uint32_t>(options.threads, 1); ++i)
+        workers.emplace_back([&queue, &run] { queue.Work(run); });
+    queue.Work(run);
+    for (auto& w : workers) w.join();
+
+    bvh.nodes.reserve(CountNodes(root) + 1);
+    bvh.nodes.resize(1);
+    Stitch(root, 0, bvh.nodes);
+    bvh.primIds.resize(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) bvh.primIds[i] = refs[i].id;
+    return bvh;
+}
+
+}  // namespace asval::builder::detail

@@ -1,0 +1,54 @@
+// Outward-rounded transforms. This file is compiled with -ffp-contract=off (see CMakeLists.txt): an FMA
+// would change the rounding the error bound below assumes.
+#include <cfloat>
+#include <cmath>
+
+#include "asval/builder/build_input.h"
+#include "conservative_bounds.h"
+
+namespace asval::builder {
+namespace detail {
+
+float RoundDown(double d) {
+    if (std::isnan(d)) return -INFINITY;
+    float f = float(d);
+    if (double(f) > d) f = std::nextafter(f, -INFINITY);
+    return f;
+}
+
+float RoundUp(double d) {
+    if (std::isnan(d)) return INFINITY;
+    float f = float(d);
+    if (double(f) < d) f = std::nextafter(f, INFINITY);
+    return f;
+}
+
+// Interval of row . [x, y, z, 1] over x in [lo0, hi0], ... Each product of two floats is exact in double
+// (24 + 24 significant bits). The three additions round; each error is at most 2^-53 of the partial sum,
+// so the total is below 3 * 2^-53 * sum|terms|. We widen by 2^-50 * sum|terms| (8 units: the widening's own
+// rounding is covered by the slack), then round outward to float.
+void RowInterval(const float row[4], const float lo[3], const float hi[3], float* outLo, float* outHi) {
+    double sLo = row[3], sHi = row[3], mag = std::fabs(double(row[3]));
+    for (int c = 0; c < 3; ++c) {
+        const double a = double(row[c]) * double(lo[c]);
+        const double b = double(row[c]) * double(hi[c]);
+        if (std::isnan(a) || std::isnan(b)) { sLo = sHi = NAN; continue; }  // NaN matrix, 0 * inf
+        const double mn = a < b ? a : b, mx = a < b ? b : a;
+        sLo += mn;
+        sHi += mx;
+        mag += std::fabs(mn) > std::fabs(mx) ? std::fabs(mn) : std::fabs(mx);
+    }
+    const double margin = mag * 0x1p-50;
+    // NaN anywhere (NaN in the matrix, inf * 0, inf - inf) ends as an infinite bound via RoundDown/RoundUp.
+    *outLo = RoundDown(sLo - margin);
+    *outHi = RoundUp(sHi + margin);
+}
+
+}  // namespace detail
+
+void TransformBoxConservative(const float m[12], const float lo[3], const float hi[3], float outLo[3],
+                              float outHi[3]) {
+    for (int r = 0; r < 3; ++r) detail::RowInterval(m + 4 * r, lo, hi, &outLo[r], &outHi[r]);
+}
+
+}  // namespace asval::builder

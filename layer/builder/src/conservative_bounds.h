@@ -1,0 +1,10 @@
+// Private: directed rounding helpers shared by the bounds code.
+#pragma once
+
+namespace asval::builder::detail {
+
+float RoundDown(double d);  // largest float <= d (NaN: -inf)
+float RoundUp(double d);    // smallest float >= d (NaN: +inf)
+void RowInterval(const float row[4], const float lo[3], const float hi[3], float* outLo, float* outHi);
+
+}  // namespace asval::builder::detail
