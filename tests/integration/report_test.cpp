@@ -160,3 +160,39 @@ TEST_CASE("a malformed setting is reported as a warning at instance creation, no
 
 }  // namespace
 }  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+// Environment variables are read when the instance is created, and win over the API structure.
+struct ScopedEnv {
+  std::string name;
+  ScopedEnv(const char* n, const char* value) : name(n) { setenv(n, value, 1); }
+  ~ScopedEnv() { unsetenv(name.c_str()); }
+};
+
+TEST_CASE("settings from the environment win over VkLayerSettingsCreateInfoEXT",
+          "[integration][report][passes-invalid-down]") {
+  ApiSettings settings;
+  settings.Add("duplicate_message_limit", "5");
+  for (const char* name : {"VK_ASVAL_AS_VALIDATION_DUPLICATE_MESSAGE_LIMIT", "VK_AS_VALIDATION_DUPLICATE_MESSAGE_LIMIT",
+                           "VK_DUPLICATE_MESSAGE_LIMIT"}) {
+    ScopedEnv env(name, "1");
+    Fixture f(settings.Chain());
+    vkkit::Device& device = f.device();
+    vkkit::TriangleBuild build(device);
+    // Recorded, never submitted: with a limit of 1 the second build is not reported and so not skipped.
+    build.UseScratchOffset(device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2);
+    f.monitor().Expect(kVuid, 1);
+    device.OneShot([&](VkCommandBuffer cb) {
+      build.Record(device, cb);
+      build.Record(device, cb);
+    }, /*submit=*/false);
+    INFO("variable " << name);
+    CHECK(f.monitor().Verify() == "");
+    build.Release(device);
+  }
+}
+
+}  // namespace
+}  // namespace asval_test

@@ -187,10 +187,11 @@ private:
         Range left, right;
         if (axis >= 0) {
             // Partition by bin on `axis`, tracking both sides' boxes and centroid boxes.
-            const float pa = _mm_cvtss_f32(_mm_shuffle_ps(P, P, axis == 0 ? 0 : axis == 1 ? 0x55 : 0xAA));
-            alignas(16) float qv[4], cv[4];
+            alignas(16) float pv[4], qv[4], cv[4];
+            _mm_store_ps(pv, P);
             _mm_store_ps(qv, Q);
             _mm_store_ps(cv, CminP);
+            const float pa = pv[axis];
             auto binOf = [&](const PrimRef& ref) {
                 alignas(16) float c[4];
                 _mm_store_ps(c, Centroid(ref));
