@@ -11,8 +11,8 @@
 namespace asval::settings_detail {
 
 struct ApiSettingEntry {
-    const VkLayerSettingEXT* entry;
-    std::string location;  // "VkLayerSettingsCreateInfoEXT #0 pSettings[2]", for messages
+  const VkLayerSettingEXT* entry;
+  std::string location;  // "VkLayerSettingsCreateInfoEXT #0 pSettings[2]", for messages
 };
 
 // Entries whose pLayerName equals `layer_name` and whose pSettingName is not NULL, in chain order

@@ -28,12 +28,12 @@ inline constexpr const char kLayerName[] =
     ;
 
 struct LayerSettings {
-    // One field per setting, named after its key, initialised to the manifest default:
-    //   uint32_t report_flags;                      LayerSettingFlagBits
-    //   uint32_t duplicate_message_limit;           0 = unlimited
-    //   std::vector<std::string> message_id_filter; VUIDs, VUID suffixes or message-id hashes, as written
-    //   std::string report_file;                    JSON-lines report path, empty = none
-    //   bool log_to_stderr;
+  // One field per setting, named after its key, initialised to the manifest default:
+  //   uint32_t report_flags;                      LayerSettingFlagBits
+  //   uint32_t duplicate_message_limit;           0 = unlimited
+  //   std::vector<std::string> message_id_filter; VUIDs, VUID suffixes or message-id hashes, as written
+  //   std::string report_file;                    JSON-lines report path, empty = none
+  //   bool log_to_stderr;
 #define ASVAL_SETTING_FLAGS(key, default_bits, default_text) uint32_t key = default_bits;
 #define ASVAL_SETTING_INT(key, cpp_type, default_value, min, max, default_text) cpp_type key = default_value;
 #define ASVAL_SETTING_BOOL(key, default_value, default_text) bool key = default_value;
@@ -41,31 +41,31 @@ struct LayerSettings {
 #define ASVAL_SETTING_LIST(key, default_value, default_text) std::vector<std::string> key = default_value;
 #include "asval_settings_defs.inc"
 
-    bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
+  bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
 
-    friend bool operator==(const LayerSettings& a, const LayerSettings& b) {
-        bool same = true;
+  friend bool operator==(const LayerSettings& a, const LayerSettings& b) {
+    bool same = true;
 #define ASVAL_SETTING_FLAGS(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_INT(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_BOOL(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_STRING(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_LIST(key, ...) same = same && a.key == b.key;
 #include "asval_settings_defs.inc"
-        return same;
-    }
-    friend bool operator!=(const LayerSettings& a, const LayerSettings& b) { return !(a == b); }
+    return same;
+  }
+  friend bool operator!=(const LayerSettings& a, const LayerSettings& b) { return !(a == b); }
 };
 
 // Where settings come from, so that tests can replace the process environment and working directory.
 struct SettingsSources {
-    // Value of an environment variable; "" when unset. Unset and empty are the same, as in VUL.
-    // Also consulted for XDG_DATA_HOME, HOME and VK_LAYER_SETTINGS_PATH.
-    std::function<std::string(const char* name)> getenv;
-    // Directory searched last for vk_layer_settings.txt; empty means a relative "vk_layer_settings.txt".
-    std::string cwd;
+  // Value of an environment variable; "" when unset. Unset and empty are the same, as in VUL.
+  // Also consulted for XDG_DATA_HOME, HOME and VK_LAYER_SETTINGS_PATH.
+  std::function<std::string(const char* name)> getenv;
+  // Directory searched last for vk_layer_settings.txt; empty means a relative "vk_layer_settings.txt".
+  std::string cwd;
 
-    // The real process environment (std::getenv) and current working directory.
-    static SettingsSources FromProcess();
+  // The real process environment (std::getenv) and current working directory.
+  static SettingsSources FromProcess();
 };
 
 // Reads every setting. Per setting, the first source that sets it wins (Vulkan-Utility-Libraries order):

@@ -24,16 +24,16 @@ namespace asval::settings_detail {
 
 // One value as found in the winning source: either text or an API entry.
 struct RawSetting {
-    std::string origin;                      // for messages, e.g. "environment variable VK_..."
-    std::string text;                        // environment or file value, when api is null
-    const VkLayerSettingEXT* api = nullptr;  // the VkLayerSettingsCreateInfoEXT entry otherwise
+  std::string origin;                      // for messages, e.g. "environment variable VK_..."
+  std::string text;                        // environment or file value, when api is null
+  const VkLayerSettingEXT* api = nullptr;  // the VkLayerSettingsCreateInfoEXT entry otherwise
 };
 
 // Name and bit of one flag of a FLAGS setting.
 struct FlagName {
-    const char* setting;
-    const char* flag;
-    uint32_t bit;
+  const char* setting;
+  const char* flag;
+  uint32_t bit;
 };
 
 bool ReadBool(const RawSetting& raw, bool* out, std::string* error);
@@ -50,10 +50,10 @@ std::string DescribeApiEntryProblem(const VkLayerSettingEXT& entry);
 // Same for integer outputs narrower than int64_t: reads, range-checks against [min, max], converts.
 template <typename Int>
 bool ReadIntegerAs(const RawSetting& raw, int64_t min, int64_t max, Int* out, std::string* error) {
-    int64_t value = 0;
-    if (!ReadInteger(raw, min, max, &value, error)) return false;
-    *out = static_cast<Int>(value);
-    return true;
+  int64_t value = 0;
+  if (!ReadInteger(raw, min, max, &value, error)) return false;
+  *out = static_cast<Int>(value);
+  return true;
 }
 
 }  // namespace asval::settings_detail

@@ -12,14 +12,14 @@
 namespace asval::settings_detail {
 
 struct SettingsFileLocation {
-    enum class Origin {
-        kVkconfig,           // $XDG_DATA_HOME (or $HOME/.local/share) /vulkan/settings.d/vk_layer_settings.txt
-        kLayerSettingsPath,  // $VK_LAYER_SETTINGS_PATH, "/vk_layer_settings.txt" appended for a directory
-        kWorkingDirectory,   // <cwd>/vk_layer_settings.txt
-    };
-    std::string path;  // may not exist: VUL stops at an existing VK_LAYER_SETTINGS_PATH directory even
-                       // when it holds no vk_layer_settings.txt, and the working-directory file is optional
-    Origin origin = Origin::kWorkingDirectory;
+  enum class Origin {
+    kVkconfig,           // $XDG_DATA_HOME (or $HOME/.local/share) /vulkan/settings.d/vk_layer_settings.txt
+    kLayerSettingsPath,  // $VK_LAYER_SETTINGS_PATH, "/vk_layer_settings.txt" appended for a directory
+    kWorkingDirectory,   // <cwd>/vk_layer_settings.txt
+  };
+  std::string path;  // may not exist: VUL stops at an existing VK_LAYER_SETTINGS_PATH directory even
+                     // when it holds no vk_layer_settings.txt, and the working-directory file is optional
+  Origin origin = Origin::kWorkingDirectory;
 };
 
 // sources.getenv(name), or "" when the callback is not set.

@@ -10,31 +10,11 @@
 #include <unistd.h>
 
 #include "fixture.h"
-#include "layer_settings_ext.h"
 
 namespace asval_test {
 namespace {
 
 constexpr const char* kVuid = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710";
-
-// A VkLayerSettingsCreateInfoEXT for asval with string settings.
-struct ApiSettings {
-  std::vector<VkLayerSettingEXT> settings;
-  std::vector<std::unique_ptr<const char*>> values;
-  VkLayerSettingsCreateInfoEXT info{};
-
-  void Add(const char* name, const char* value) {
-    values.push_back(std::make_unique<const char*>(value));
-    settings.push_back(VkLayerSettingEXT{"VK_LAYER_ASVAL_as_validation", name, VK_LAYER_SETTING_TYPE_STRING_EXT, 1,
-                                         values.back().get()});
-  }
-  const void* Chain() {
-    info.sType = VK_STRUCTURE_TYPE_LAYER_SETTINGS_CREATE_INFO_EXT;
-    info.settingCount = static_cast<uint32_t>(settings.size());
-    info.pSettings = settings.data();
-    return &info;
-  }
-};
 
 void RecordMisalignedBuilds(vkkit::Device& device, vkkit::TriangleBuild& build, int times) {
   build.UseScratchOffset(device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2);
