@@ -16,6 +16,14 @@ class Location {
   // The root: the command itself, e.g. "vkCmdBuildAccelerationStructuresKHR".
   explicit Location(const char* function) : function_(function) {}
 
+  // Copies only the elements in use: a root Location costs three stores, which matters because every
+  // intercepted call builds one whether or not anything is reported.
+  Location(const Location& other)
+      : function_(other.function_), depth_(other.depth_), truncated_(other.truncated_) {
+    for (int i = 0; i < depth_; ++i) elements_[i] = other.elements_[i];
+  }
+  Location& operator=(const Location&) = delete;
+
   // A field of this location, optionally indexed: loc.Field("pInfos", i).Field("scratchData").
   Location Field(const char* field, int64_t index = kNoIndex) const {
     Location child = *this;
@@ -38,7 +46,7 @@ class Location {
   };
 
   const char* function_;
-  Element elements_[kMaxDepth] = {};
+  Element elements_[kMaxDepth];  // only [0, depth_) is ever read
   int depth_ = 0;
   bool truncated_ = false;
 };

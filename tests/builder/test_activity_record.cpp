@@ -1,6 +1,7 @@
 // Activity records: bit layout, CompareActivity against a brute-force comparison, the index hash.
 #include <catch2/catch_test_macros.hpp>
 
+#include <limits>
 #include <vector>
 
 #include "asval/builder/activity_record.h"

@@ -117,6 +117,7 @@ private:
         _mm_store_ps(clo, r.clo);
         _mm_store_ps(chi, r.chi);
         const bool forceMedian = r.depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth;
+        if (forceMedian && count <= maxLeaf_) { MakeLeaf(task, slot, r); return; }
 
         int axis = -1;
         uint32_t splitBin = 0;

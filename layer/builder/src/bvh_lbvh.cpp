@@ -36,7 +36,7 @@ public:
         const uint32_t count = e - b;
         if (count == 1) return Leaf(slot, b, e);
         uint32_t mid;
-        if (depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth) {
+        if (depth + HalvingLevels(count, 1) >= kMaxDepth) {  // this recursion goes down to single references
             mid = b + count / 2;
         } else {
             // Highest bit (at or below `bit`) where the first and last codes differ.

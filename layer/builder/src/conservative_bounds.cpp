@@ -23,25 +23,38 @@ float RoundUp(double d) {
     return f;
 }
 
+// Error-free addition (Knuth's TwoSum): s + err == a + b exactly.
+inline double TwoSum(double a, double b, double* err) {
+    const double s = a + b;
+    const double bb = s - a;
+    *err = (a - (s - bb)) + (b - bb);
+    return s;
+}
+
 // Interval of row . [x, y, z, 1] over x in [lo0, hi0], ... Each product of two floats is exact in double
-// (24 + 24 significant bits). The three additions round; each error is at most 2^-53 of the partial sum,
-// so the total is below 3 * 2^-53 * sum|terms|. We widen by 2^-50 * sum|terms| (8 units: the widening's own
-// rounding is covered by the slack), then round outward to float.
+// (24 + 24 significant bits). The three additions are error-free transformed: when every error is zero the
+// double sum is exact and only the final rounding to float (directed) remains. Otherwise each error is at
+// most 2^-53 of its partial sum, so the total is below 3 * 2^-53 * sum|terms|; we widen by 2^-50 * sum|terms|
+// (the widening's own rounding is covered by the slack) and round outward.
 void RowInterval(const float row[4], const float lo[3], const float hi[3], float* outLo, float* outHi) {
     double sLo = row[3], sHi = row[3], mag = std::fabs(double(row[3]));
+    bool exactLo = true, exactHi = true;
     for (int c = 0; c < 3; ++c) {
         const double a = double(row[c]) * double(lo[c]);
         const double b = double(row[c]) * double(hi[c]);
         if (std::isnan(a) || std::isnan(b)) { sLo = sHi = NAN; continue; }  // NaN matrix, 0 * inf
         const double mn = a < b ? a : b, mx = a < b ? b : a;
-        sLo += mn;
-        sHi += mx;
+        double e;
+        sLo = TwoSum(sLo, mn, &e);
+        exactLo &= e == 0;
+        sHi = TwoSum(sHi, mx, &e);
+        exactHi &= e == 0;
         mag += std::fabs(mn) > std::fabs(mx) ? std::fabs(mn) : std::fabs(mx);
     }
     const double margin = mag * 0x1p-50;
     // NaN anywhere (NaN in the matrix, inf * 0, inf - inf) ends as an infinite bound via RoundDown/RoundUp.
-    *outLo = RoundDown(sLo - margin);
-    *outHi = RoundUp(sHi + margin);
+    *outLo = RoundDown(exactLo ? sLo : sLo - margin);
+    *outHi = RoundUp(exactHi ? sHi : sHi + margin);
 }
 
 }  // namespace detail
