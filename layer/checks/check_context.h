@@ -2,6 +2,7 @@
 // What every check sees: the device's shadow state (read-only) and the reporter. Checks return true when
 // the app asked (through a callback returning VK_TRUE) that the call not be passed down.
 #include "device_state.h"
+#include "layer_settings.h"
 #include "location.h"
 #include "reporter.h"
 
@@ -10,6 +11,9 @@ namespace asval {
 struct CheckContext {
   const DeviceState& state;
   Reporter& reporter;
+  uint32_t enabled_checks;  // LayerSettingFlagBits kCheck*: the families the settings enable
+
+  bool Enabled(LayerSettingFlagBits family) const { return (enabled_checks & family) != 0; }
 };
 
 }  // namespace asval

@@ -10,11 +10,13 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
     VkCommandBuffer commandBuffer, uint32_t infoCount, const VkAccelerationStructureBuildGeometryInfoKHR* pInfos,
     const VkAccelerationStructureBuildRangeInfoKHR* const* ppBuildRangeInfos) {
   DeviceData* data = GetDeviceData(commandBuffer);
-  const CheckContext ctx{data->state, *data->reporter};
+  const CheckContext ctx{data->state, *data->reporter, data->instance->settings.enabled_checks};
   const Location loc("vkCmdBuildAccelerationStructuresKHR");
   bool skip = false;
-  skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
-                                   "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710");
+  if (ctx.Enabled(kCheckAlignment)) {
+    skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
+                                     "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710");
+  }
   if (skip) return;
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
 }
@@ -24,11 +26,13 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
     const VkDeviceAddress* pIndirectDeviceAddresses, const uint32_t* pIndirectStrides,
     const uint32_t* const* ppMaxPrimitiveCounts) {
   DeviceData* data = GetDeviceData(commandBuffer);
-  const CheckContext ctx{data->state, *data->reporter};
+  const CheckContext ctx{data->state, *data->reporter, data->instance->settings.enabled_checks};
   const Location loc("vkCmdBuildAccelerationStructuresIndirectKHR");
   bool skip = false;
-  skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
-                                   "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03710");
+  if (ctx.Enabled(kCheckAlignment)) {
+    skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
+                                     "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03710");
+  }
   if (skip) return;
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);

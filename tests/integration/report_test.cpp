@@ -176,3 +176,21 @@ TEST_CASE("settings from the environment win over VkLayerSettingsCreateInfoEXT",
 
 }  // namespace
 }  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+TEST_CASE("enabled_checks: a family left out is not checked", "[integration][report][passes-invalid-down]") {
+  ApiSettings settings;
+  settings.Add("enabled_checks", "features,handles,structure,addresses,aliasing,host,copies,history");
+  Fixture f(settings.Chain());
+  vkkit::Device& device = f.device();
+  vkkit::TriangleBuild build(device);
+  build.UseScratchOffset(device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2);
+  device.OneShot([&](VkCommandBuffer cb) { build.Record(device, cb); }, /*submit=*/false);
+  CHECK(f.monitor().Verify() == "");
+  build.Release(device);
+}
+
+}  // namespace
+}  // namespace asval_test

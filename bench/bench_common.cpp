@@ -1,0 +1,37 @@
+#include "bench_common.h"
+
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include "alloc_counter.h"
+
+namespace bench {
+
+const scenes::Scene& CachedScene(const std::string& name, uint32_t triangles) {
+    static std::map<std::pair<std::string, uint32_t>, std::unique_ptr<scenes::Scene>> cache;
+    auto& slot = cache[{name, triangles}];
+    if (!slot) slot = std::make_unique<scenes::Scene>(scenes::ByName(name, triangles));
+    return *slot;
+}
+
+BuildRun RunBuild(const scenes::Scene& s, const asval::builder::BuildOptions& o) {
+    using clock = std::chrono::steady_clock;
+    BuildRun r;
+    alloccount::ResetPeak();
+    const size_t before = alloccount::CurrentBytes();
+    const auto t0 = clock::now();
+    asval::builder::BuildInput in;
+    asval::builder::AppendTriangles(scenes::View(s), true, 0, &in);
+    const auto t1 = clock::now();
+    asval::builder::Bvh bvh = asval::builder::BuildBvh(std::move(in), o);
+    const auto t2 = clock::now();
+    r.peakBytes = alloccount::PeakBytes() - before;
+    r.seconds = std::chrono::duration<double>(t2 - t0).count();
+    r.prepareSeconds = std::chrono::duration<double>(t1 - t0).count();
+    r.sah = asval::builder::SahCost(bvh);
+    r.stats = bvh.stats;
+    return r;
+}
+
+}  // namespace bench

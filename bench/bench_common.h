@@ -1,0 +1,24 @@
+// Scene cache and one timed build, shared by the Google Benchmark suite and the sweep tool.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "asval/builder/bvh.h"
+#include "scenes.h"
+
+namespace bench {
+
+const scenes::Scene& CachedScene(const std::string& name, uint32_t triangles);
+
+struct BuildRun {
+    double seconds = 0;          // AppendTriangles + BuildBvh, wall clock
+    double prepareSeconds = 0;   // AppendTriangles alone (classification + conservative boxes)
+    double sah = 0;
+    size_t peakBytes = 0;        // heap peak above the scene itself
+    asval::builder::BuildStats stats;
+};
+
+BuildRun RunBuild(const scenes::Scene& s, const asval::builder::BuildOptions& o);
+
+}  // namespace bench
