@@ -195,7 +195,13 @@ bool ReadFlags(const RawSetting& raw, const char* setting, const FlagName* flags
     const VkLayerSettingEXT& entry = *raw.api;
     if (std::string problem = DescribeApiEntryProblem(entry); !problem.empty()) return Fail(error, problem);
     if (entry.type != VK_LAYER_SETTING_TYPE_STRING_EXT) return WrongType(entry, "STRING values (flag names)", error);
-    if (!ApiStrings(entry, &names, error)) return false;
+    std::vector<std::string> values;
+    if (!ApiStrings(entry, &values, error)) return false;
+    // Each value may itself be a list ("error,warn"), as in the settings file: flag names never contain
+    // a delimiter, so splitting is never wrong and saves apps from building one value per flag.
+    for (const std::string& value : values) {
+      for (std::string& name : SplitList(value)) names.push_back(std::move(name));
+    }
   }
   uint32_t bits = 0;
   for (const std::string& name : names) {
