@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turns scripts/checks.json (the registry of asval's checks) into docs/coverage.md.
+"""Turns scripts/checks.json and scripts/checks/*.json (the registry of asval's checks) into docs/coverage.md.
 
 The registry names, for every VUID the layer checks or has decided it cannot check, its family (a flag of
 the enabled_checks setting in scripts/settings.json), its status and the tests that exercise it. This
@@ -155,6 +155,10 @@ def main():
     parser.add_argument("--verify", action="store_true", help="fail if the registry is wrong or the doc stale")
     args = parser.parse_args()
     registry = load_json("scripts/checks.json")
+    registry["checks"] = []
+    for name in sorted(os.listdir(os.path.join(ROOT, "scripts", "checks"))):
+        if name.endswith(".json"):
+            registry["checks"] += load_json(os.path.join("scripts", "checks", name))
     family_names = families()
     newest, older = spec_vuids()
     errors = validate(registry, family_names, newest, older, test_sources())

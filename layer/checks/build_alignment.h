@@ -1,15 +1,13 @@
 #pragma once
-// Alignment rules of the acceleration-structure build commands.
-#include <vulkan/vulkan.h>
-
+// Alignment rules of the acceleration-structure build commands (family "alignment").
+#include "build_command.h"
 #include "check_context.h"
 
 namespace asval {
 
 // VUID-vkCmdBuildAccelerationStructures{,Indirect}KHR-pInfos-03710: each pInfos[i].scratchData.deviceAddress
-// must be a multiple of minAccelerationStructureScratchOffsetAlignment. vuid names the command's own rule.
-bool ValidateScratchAlignment(const CheckContext& ctx, const Location& loc, VkCommandBuffer command_buffer,
-                              uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                              const char* vuid);
+// is a multiple of minAccelerationStructureScratchOffsetAlignment (device builds only: host scratch is a
+// host pointer).
+bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd);
 
 }  // namespace asval

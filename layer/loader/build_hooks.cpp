@@ -1,23 +1,30 @@
-// The acceleration-structure build commands: run the checks, then pass the call down unless the app's
-// callback asked to skip it.
-#include "build_alignment.h"
+// The acceleration-structure build commands: describe the call as a BuildCommand, run the enabled rule
+// families over it, then pass the call down unless the app's callback asked to skip it.
+#include "build_validation.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
 
+namespace {
+
+CheckContext MakeCheckContext(const DeviceData& data) {
+  return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
+}
+
+}  // namespace
+
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
     VkCommandBuffer commandBuffer, uint32_t infoCount, const VkAccelerationStructureBuildGeometryInfoKHR* pInfos,
     const VkAccelerationStructureBuildRangeInfoKHR* const* ppBuildRangeInfos) {
   DeviceData* data = GetDeviceData(commandBuffer);
-  const CheckContext ctx{data->state, *data->reporter, data->instance->settings.enabled_checks};
-  const Location loc("vkCmdBuildAccelerationStructuresKHR");
-  bool skip = false;
-  if (ctx.Enabled(kCheckAlignment)) {
-    skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
-                                     "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710");
-  }
-  if (skip) return;
+  BuildCommand cmd{BuildCommandKind::kCmdBuild, "vkCmdBuildAccelerationStructuresKHR"};
+  cmd.device = data->device;
+  cmd.command_buffer = commandBuffer;
+  cmd.info_count = infoCount;
+  cmd.infos = pInfos;
+  cmd.ranges = ppBuildRangeInfos;
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
 }
 
@@ -26,14 +33,15 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
     const VkDeviceAddress* pIndirectDeviceAddresses, const uint32_t* pIndirectStrides,
     const uint32_t* const* ppMaxPrimitiveCounts) {
   DeviceData* data = GetDeviceData(commandBuffer);
-  const CheckContext ctx{data->state, *data->reporter, data->instance->settings.enabled_checks};
-  const Location loc("vkCmdBuildAccelerationStructuresIndirectKHR");
-  bool skip = false;
-  if (ctx.Enabled(kCheckAlignment)) {
-    skip |= ValidateScratchAlignment(ctx, loc, commandBuffer, infoCount, pInfos,
-                                     "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03710");
-  }
-  if (skip) return;
+  BuildCommand cmd{BuildCommandKind::kCmdBuildIndirect, "vkCmdBuildAccelerationStructuresIndirectKHR"};
+  cmd.device = data->device;
+  cmd.command_buffer = commandBuffer;
+  cmd.info_count = infoCount;
+  cmd.infos = pInfos;
+  cmd.indirect_addresses = pIndirectDeviceAddresses;
+  cmd.indirect_strides = pIndirectStrides;
+  cmd.max_primitive_counts = ppMaxPrimitiveCounts;
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);
 }
@@ -43,8 +51,15 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
     const VkAccelerationStructureBuildGeometryInfoKHR* pInfos,
     const VkAccelerationStructureBuildRangeInfoKHR* const* ppBuildRangeInfos) {
   DeviceData* data = GetDeviceData(device);
-  // Host builds have no scratch-alignment rule (scratchData is a host address); their checks come with the
-  // record-time checks issue.
+  BuildCommand cmd{BuildCommandKind::kHostBuild, "vkBuildAccelerationStructuresKHR"};
+  cmd.device = device;
+  cmd.deferred_operation = deferredOperation;
+  cmd.info_count = infoCount;
+  cmd.infos = pInfos;
+  cmd.ranges = ppBuildRangeInfos;
+  // Skipped by the app's callback: the build did not happen. VK_ERROR_VALIDATION_FAILED_EXT is what the
+  // Khronos layer returns in that case.
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return VK_ERROR_VALIDATION_FAILED_EXT;
   return data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos,
                                                        ppBuildRangeInfos);
 }

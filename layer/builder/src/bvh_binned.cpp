@@ -19,6 +19,7 @@ namespace {
 
 constexpr uint32_t kSpawnRefs = 4096;
 constexpr uint32_t kMaxBins = 64;
+constexpr uint32_t kSweepMax = 12;  // nodes this small get an exact SAH sweep instead of bins
 
 struct Range {
     uint32_t begin, end;
@@ -95,138 +96,196 @@ private:
         n.count = r.end - r.begin;
     }
 
-    // Box and centroid box of refs[b, e).
-    void Measure(uint32_t b, uint32_t e, Range* r) const {
+    // Running box + centroid box of one side of a split.
+    struct Side {
         __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-        __m128 clo = lo, chi = hi;
-        for (uint32_t i = b; i < e; ++i) {
-            lo = _mm_min_ps(lo, LoadLo(refs_[i]));
-            hi = _mm_max_ps(hi, LoadHi(refs_[i]));
-            const __m128 c = Centroid(refs_[i]);
+        __m128 clo = _mm_set1_ps(INFINITY), chi = _mm_set1_ps(-INFINITY);
+        void Add(const PrimRef& ref) {
+            lo = _mm_min_ps(lo, LoadLo(ref));
+            hi = _mm_max_ps(hi, LoadHi(ref));
+            const __m128 c = Centroid(ref);
             clo = _mm_min_ps(clo, c);
             chi = _mm_max_ps(chi, c);
         }
-        r->begin = b; r->end = e; r->lo = lo; r->hi = hi; r->clo = clo; r->chi = chi;
+        Range ToRange(uint32_t b, uint32_t e, uint32_t depth) const { return Range{b, e, lo, hi, clo, chi, depth}; }
+    };
+
+    static float Lane(__m128 v, int axis) {
+        alignas(16) float f[4];
+        _mm_store_ps(f, v);
+        return f[axis];
+    }
+
+    // Full SAH sweep for small nodes: sort by centroid on each axis, evaluate every split position.
+    // Returns false when no split exists (identical centroids on every axis).
+    bool SweepSmall(const Range& r, double* bestCost, Range* left, Range* right) {
+        constexpr uint32_t kMax = kSweepMax;
+        const uint32_t count = r.end - r.begin;
+        struct Entry { float key; uint32_t index; };
+        Entry order[3][kMax];
+        double rightArea[kMax];
+        int bestAxis = -1;
+        uint32_t bestSplit = 0;
+        *bestCost = INFINITY;
+        for (int a = 0; a < 3; ++a) {
+            if (!(Lane(r.chi, a) > Lane(r.clo, a))) continue;
+            Entry* o = order[a];
+            for (uint32_t i = 0; i < count; ++i) {
+                // Insertion sort; ties by position keep it deterministic.
+                const Entry e{Lane(Centroid(refs_[r.begin + i]), a), i};
+                uint32_t k = i;
+                while (k > 0 && o[k - 1].key > e.key) { o[k] = o[k - 1]; --k; }
+                o[k] = e;
+            }
+            __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+            for (uint32_t k = count - 1; k > 0; --k) {
+                lo = _mm_min_ps(lo, LoadLo(refs_[r.begin + o[k].index]));
+                hi = _mm_max_ps(hi, LoadHi(refs_[r.begin + o[k].index]));
+                rightArea[k] = HalfArea(lo, hi);
+            }
+            lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
+            for (uint32_t k = 0; k + 1 < count; ++k) {
+                lo = _mm_min_ps(lo, LoadLo(refs_[r.begin + o[k].index]));
+                hi = _mm_max_ps(hi, LoadHi(refs_[r.begin + o[k].index]));
+                const double cost = HalfArea(lo, hi) * (k + 1) + rightArea[k + 1] * (count - k - 1);
+                if (cost < *bestCost) { *bestCost = cost; bestAxis = a; bestSplit = k + 1; }
+            }
+        }
+        if (bestAxis < 0) return false;
+        PrimRef sorted[kMax];
+        for (uint32_t k = 0; k < count; ++k) sorted[k] = refs_[r.begin + order[bestAxis][k].index];
+        Side l, rr;
+        for (uint32_t k = 0; k < count; ++k) {
+            refs_[r.begin + k] = sorted[k];
+            (k < bestSplit ? l : rr).Add(sorted[k]);
+        }
+        *left = l.ToRange(r.begin, r.begin + bestSplit, r.depth + 1);
+        *right = rr.ToRange(r.begin + bestSplit, r.end, r.depth + 1);
+        return true;
+    }
+
+    // Binned SAH for larger nodes. Returns false when no bin split exists.
+    bool Binned(const Range& r, double* bestCost, Range* left, Range* right) {
+        alignas(16) float clo[4], chi[4];
+        _mm_store_ps(clo, r.clo);
+        _mm_store_ps(chi, r.chi);
+        // Bin coordinate t = (c * p - cmin * p) * q, p a power of two keeping tiny (subnormal) and huge
+        // extents in range; garbage lanes clamp into [0, bins) and only cost quality.
+        alignas(16) float p[4] = {1, 1, 1, 1}, q[4] = {0, 0, 0, 0}, cminp[4] = {0, 0, 0, 0};
+        for (int a = 0; a < 3; ++a) {
+            const double extent = double(chi[a]) - double(clo[a]);
+            if (!(extent > 0)) continue;
+            p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
+            q[a] = float(double(bins_) * (1 - 1e-6) / (extent * double(p[a])));
+            cminp[a] = clo[a] * p[a];
+        }
+        const __m128 P = _mm_load_ps(p), Q = _mm_load_ps(q), CminP = _mm_load_ps(cminp);
+        const __m128 maxBin = _mm_set1_ps(float(bins_ - 1)), zero = _mm_setzero_ps();
+        auto binOf = [&](const PrimRef& ref) {
+            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(ref), P), CminP), Q);
+            return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, zero), maxBin));  // NaN -> 0
+        };
+
+        Bin bins[3][kMaxBins];
+        uint32_t counts[3][kMaxBins] = {};
+        for (int a = 0; a < 3; ++a)
+            for (uint32_t k = 0; k < bins_; ++k) bins[a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+        for (uint32_t i = r.begin; i < r.end; ++i) {
+            const PrimRef& ref = refs_[i];
+            alignas(16) int32_t k[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(ref));
+            const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
+            for (int a = 0; a < 3; ++a) {
+                Bin& b = bins[a][k[a]];
+                b.lo = _mm_min_ps(b.lo, lo);
+                b.hi = _mm_max_ps(b.hi, hi);
+                ++counts[a][k[a]];
+            }
+        }
+        int axis = -1;
+        uint32_t splitBin = 0;
+        *bestCost = INFINITY;
+        for (int a = 0; a < 3; ++a) {
+            if (q[a] == 0) continue;
+            double rightArea[kMaxBins];
+            uint32_t rightCount[kMaxBins];
+            __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+            uint32_t n = 0;
+            for (uint32_t k = bins_ - 1; k > 0; --k) {
+                lo = _mm_min_ps(lo, bins[a][k].lo);
+                hi = _mm_max_ps(hi, bins[a][k].hi);
+                n += counts[a][k];
+                rightArea[k] = HalfArea(lo, hi);
+                rightCount[k] = n;
+            }
+            lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
+            n = 0;
+            for (uint32_t k = 0; k + 1 < bins_; ++k) {
+                lo = _mm_min_ps(lo, bins[a][k].lo);
+                hi = _mm_max_ps(hi, bins[a][k].hi);
+                n += counts[a][k];
+                if (n == 0 || rightCount[k + 1] == 0) continue;
+                const double cost = HalfArea(lo, hi) * n + rightArea[k + 1] * rightCount[k + 1];
+                if (cost < *bestCost) { *bestCost = cost; axis = a; splitBin = k + 1; }
+            }
+        }
+        if (axis < 0) return false;
+        // Partition by bin on `axis` (the same arithmetic as the binning pass, so the sides match the bins),
+        // measuring each side as its references are visited.
+        alignas(16) int32_t sel[4] = {0, 0, 0, 0};
+        sel[axis] = -1;
+        const __m128i axisMask = _mm_load_si128(reinterpret_cast<const __m128i*>(sel));
+        const __m128i split = _mm_set1_epi32(int32_t(splitBin));
+        auto isLeft = [&](const PrimRef& ref) {
+            const __m128i lt = _mm_and_si128(_mm_cmplt_epi32(binOf(ref), split), axisMask);
+            return _mm_movemask_epi8(lt) != 0;
+        };
+        Side l, rr;
+        uint32_t i = r.begin, j = r.end;
+        for (;;) {
+            while (i < j && isLeft(refs_[i])) l.Add(refs_[i++]);
+            while (i < j && !isLeft(refs_[j - 1])) rr.Add(refs_[--j]);
+            if (i >= j) break;
+            std::swap(refs_[i], refs_[j - 1]);
+            l.Add(refs_[i++]);
+            rr.Add(refs_[--j]);
+        }
+        *left = l.ToRange(r.begin, i, r.depth + 1);
+        *right = rr.ToRange(i, r.end, r.depth + 1);
+        return true;
     }
 
     void Build(Task* task, uint32_t slot, Range r) {
         const uint32_t count = r.end - r.begin;
         if (count == 1) { MakeLeaf(task, slot, r); return; }
-
-        alignas(16) float clo[4], chi[4];
-        _mm_store_ps(clo, r.clo);
-        _mm_store_ps(chi, r.chi);
         const bool forceMedian = r.depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth;
         if (forceMedian && count <= maxLeaf_) { MakeLeaf(task, slot, r); return; }
 
-        int axis = -1;
-        uint32_t splitBin = 0;
-        double bestCost = INFINITY;
-        __m128 P, Q, CminP;
-        if (!forceMedian) {
-            // Bin coordinate t = (c * p - cmin * p) * q, p a power of two keeping tiny (subnormal) and
-            // huge extents in range; garbage lanes clamp into [0, bins) and only cost quality.
-            alignas(16) float p[4] = {1, 1, 1, 1}, q[4] = {0, 0, 0, 0}, cminp[4] = {0, 0, 0, 0};
-            for (int a = 0; a < 3; ++a) {
-                const double extent = double(chi[a]) - double(clo[a]);
-                if (!(extent > 0)) continue;
-                p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
-                q[a] = float(double(bins_) * (1 - 1e-6) / (extent * double(p[a])));
-                cminp[a] = clo[a] * p[a];
-            }
-            P = _mm_load_ps(p); Q = _mm_load_ps(q); CminP = _mm_load_ps(cminp);
-            const __m128 maxBin = _mm_set1_ps(float(bins_ - 1)), zero = _mm_setzero_ps();
-
-            Bin bins[3][kMaxBins];
-            uint32_t counts[3][kMaxBins] = {};
-            for (int a = 0; a < 3; ++a)
-                for (uint32_t k = 0; k < bins_; ++k) bins[a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
-            for (uint32_t i = r.begin; i < r.end; ++i) {
-                const PrimRef& ref = refs_[i];
-                const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(ref), P), CminP), Q);
-                alignas(16) int32_t k[4];
-                _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, zero), maxBin)));
-                const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
-                for (int a = 0; a < 3; ++a) {
-                    Bin& b = bins[a][k[a]];
-                    b.lo = _mm_min_ps(b.lo, lo);
-                    b.hi = _mm_max_ps(b.hi, hi);
-                    ++counts[a][k[a]];
-                }
-            }
-            // Sweep: right-to-left prefix areas, then left-to-right cost.
-            for (int a = 0; a < 3; ++a) {
-                if (q[a] == 0) continue;
-                double rightArea[kMaxBins];
-                uint32_t rightCount[kMaxBins];
-                __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-                uint32_t n = 0;
-                for (uint32_t k = bins_ - 1; k > 0; --k) {
-                    lo = _mm_min_ps(lo, bins[a][k].lo);
-                    hi = _mm_max_ps(hi, bins[a][k].hi);
-                    n += counts[a][k];
-                    rightArea[k] = n ? HalfArea(lo, hi) : 0.0;
-                    rightCount[k] = n;
-                }
-                lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
-                n = 0;
-                for (uint32_t k = 0; k + 1 < bins_; ++k) {
-                    lo = _mm_min_ps(lo, bins[a][k].lo);
-                    hi = _mm_max_ps(hi, bins[a][k].hi);
-                    n += counts[a][k];
-                    if (n == 0 || rightCount[k + 1] == 0) continue;
-                    const double cost = HalfArea(lo, hi) * n + rightArea[k + 1] * rightCount[k + 1];
-                    if (cost < bestCost) { bestCost = cost; axis = a; splitBin = k + 1; }
-                }
-            }
-            if (count <= maxLeaf_) {
-                const double nodeArea = HalfArea(r.lo, r.hi);
-                if (axis < 0 || !(nodeArea + bestCost < nodeArea * count)) { MakeLeaf(task, slot, r); return; }
-            }
-        }
-
         Range left, right;
-        if (axis >= 0) {
-            // Partition by bin on `axis`, tracking both sides' boxes and centroid boxes.
-            alignas(16) float pv[4], qv[4], cv[4];
-            _mm_store_ps(pv, P);
-            _mm_store_ps(qv, Q);
-            _mm_store_ps(cv, CminP);
-            const float pa = pv[axis];
-            auto binOf = [&](const PrimRef& ref) {
-                alignas(16) float c[4];
-                _mm_store_ps(c, Centroid(ref));
-                float t = (c[axis] * pa - cv[axis]) * qv[axis];
-                t = t > 0 ? t : 0;  // NaN -> 0, as in the binning pass
-                t = t < float(bins_ - 1) ? t : float(bins_ - 1);
-                return uint32_t(t);
-            };
-            uint32_t i = r.begin, j = r.end;
-            while (i < j) {
-                if (binOf(refs_[i]) < splitBin) { ++i; continue; }
-                --j;
-                std::swap(refs_[i], refs_[j]);
-            }
-            Measure(r.begin, i, &left);
-            Measure(i, r.end, &right);
-        } else {
+        double cost = INFINITY;
+        bool found = false;
+        if (!forceMedian) found = count <= kSweepMax ? SweepSmall(r, &cost, &left, &right) : Binned(r, &cost, &left, &right);
+        if (count <= maxLeaf_) {
+            const double nodeArea = HalfArea(r.lo, r.hi);
+            if (!found || !(nodeArea + cost < nodeArea * count)) { MakeLeaf(task, slot, r); return; }
+        }
+        if (!found) {
             // No usable SAH split (identical centroids, depth budget): halve; by centroid when they differ.
             int wide = 0;
             for (int a = 1; a < 3; ++a)
-                if (double(chi[a]) - double(clo[a]) > double(chi[wide]) - double(clo[wide])) wide = a;
+                if (double(Lane(r.chi, a)) - double(Lane(r.clo, a)) > double(Lane(r.chi, wide)) - double(Lane(r.clo, wide))) wide = a;
             const uint32_t mid = r.begin + count / 2;
-            if (chi[wide] > clo[wide]) {
+            if (Lane(r.chi, wide) > Lane(r.clo, wide)) {
                 std::nth_element(refs_ + r.begin, refs_ + mid, refs_ + r.end, [wide](const PrimRef& x, const PrimRef& y) {
-                    alignas(16) float cx[4], cy[4];
-                    _mm_store_ps(cx, Centroid(x));
-                    _mm_store_ps(cy, Centroid(y));
-                    return cx[wide] < cy[wide] || (cx[wide] == cy[wide] && x.id < y.id);
+                    const float cx = Lane(Centroid(x), wide), cy = Lane(Centroid(y), wide);
+                    return cx < cy || (cx == cy && x.id < y.id);
                 });
             }
-            Measure(r.begin, mid, &left);
-            Measure(mid, r.end, &right);
+            Side l, rr;
+            for (uint32_t i = r.begin; i < r.end; ++i) (i < mid ? l : rr).Add(refs_[i]);
+            left = l.ToRange(r.begin, mid, r.depth + 1);
+            right = rr.ToRange(mid, r.end, r.depth + 1);
         }
-        left.depth = right.depth = r.depth + 1;
 
         const uint32_t childSlot = uint32_t(task->nodes.size());
         task->nodes.emplace_back();

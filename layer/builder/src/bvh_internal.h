@@ -1,6 +1,7 @@
 // Private: SIMD box helpers and the pieces both build modes share.
 #pragma once
 
+#include <emmintrin.h>
 #include <xmmintrin.h>
 #include <cfloat>
 #include <cstdint>
@@ -21,18 +22,17 @@ inline __m128 Centroid(const PrimRef& r) {
     return _mm_add_ps(_mm_mul_ps(lo, half), _mm_mul_ps(hi, half));
 }
 
-// Half surface area in double, coordinates clamped to +-FLT_MAX: finite for any non-NaN box.
+// Half surface area in double, coordinates clamped to +-FLT_MAX: finite for any non-NaN box; an empty
+// box (lo = +inf, hi = -inf) has area 0.
 inline double HalfArea(__m128 lo, __m128 hi) {
-    alignas(16) float l[4], h[4];
-    _mm_store_ps(l, lo);
-    _mm_store_ps(h, hi);
-    double e[3];
-    for (int i = 0; i < 3; ++i) {
-        const double a = l[i] < -FLT_MAX ? -FLT_MAX : (l[i] > FLT_MAX ? FLT_MAX : l[i]);
-        const double b = h[i] < -FLT_MAX ? -FLT_MAX : (h[i] > FLT_MAX ? FLT_MAX : h[i]);
-        e[i] = b > a ? b - a : 0.0;
-    }
-    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+    const __m128 big = _mm_set1_ps(FLT_MAX), small = _mm_set1_ps(-FLT_MAX);
+    lo = _mm_max_ps(_mm_min_ps(lo, big), small);
+    hi = _mm_max_ps(_mm_min_ps(hi, big), small);
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d e01 = _mm_max_pd(_mm_sub_pd(_mm_cvtps_pd(hi), _mm_cvtps_pd(lo)), zero);
+    const __m128d e2 = _mm_max_pd(_mm_sub_pd(_mm_cvtps_pd(_mm_movehl_ps(hi, hi)), _mm_cvtps_pd(_mm_movehl_ps(lo, lo))), zero);
+    const double ex = _mm_cvtsd_f64(e01), ey = _mm_cvtsd_f64(_mm_unpackhi_pd(e01, e01)), ez = _mm_cvtsd_f64(e2);
+    return ex * ey + ey * ez + ez * ex;
 }
 
 inline void StoreNodeBox(BvhNode& n, __m128 lo, __m128 hi) {
