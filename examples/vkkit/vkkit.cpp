@@ -44,19 +44,24 @@ Instance::Instance(const InstanceOptions& options) {
 
 Instance::~Instance() { vkDestroyInstance(instance_, nullptr); }
 
+bool HasDeviceExtension(VkPhysicalDevice gpu, const char* name) {
+  uint32_t n = 0;
+  vkEnumerateDeviceExtensionProperties(gpu, nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> exts(n);
+  vkEnumerateDeviceExtensionProperties(gpu, nullptr, &n, exts.data());
+  for (const VkExtensionProperties& e : exts) {
+    if (std::strcmp(e.extensionName, name) == 0) return true;
+  }
+  return false;
+}
+
 VkPhysicalDevice Instance::FindRayTracingGpu() const {
   uint32_t count = 0;
   vkEnumeratePhysicalDevices(instance_, &count, nullptr);
   std::vector<VkPhysicalDevice> gpus(count);
   vkEnumeratePhysicalDevices(instance_, &count, gpus.data());
   for (VkPhysicalDevice gpu : gpus) {
-    uint32_t n = 0;
-    vkEnumerateDeviceExtensionProperties(gpu, nullptr, &n, nullptr);
-    std::vector<VkExtensionProperties> exts(n);
-    vkEnumerateDeviceExtensionProperties(gpu, nullptr, &n, exts.data());
-    for (const VkExtensionProperties& e : exts) {
-      if (std::strcmp(e.extensionName, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) == 0) return gpu;
-    }
+    if (HasDeviceExtension(gpu, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME)) return gpu;
   }
   return VK_NULL_HANDLE;
 }
@@ -78,17 +83,25 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu) : instance_(insta
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
 
-  // rayQuery is enabled too: the Khronos layer 1.3.239 (stacked below asval in self-validation runs)
-  // requires rayQuery or rayTracingPipeline for acceleration-structure size queries.
+  // rayQuery (or, where the device lacks it, rayTracingPipeline: NVIDIA's driver has no ray queries) is
+  // enabled too: the Khronos layer 1.3.239 (stacked below asval in self-validation runs) requires one of
+  // them for acceleration-structure size queries.
+  const bool has_ray_query = HasDeviceExtension(gpu, VK_KHR_RAY_QUERY_EXTENSION_NAME);
   VkPhysicalDeviceRayQueryFeaturesKHR ray_query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
   ray_query.rayQuery = VK_TRUE;
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR pipeline{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  pipeline.rayTracingPipeline = VK_TRUE;
   VkPhysicalDeviceAccelerationStructureFeaturesKHR as_features{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &ray_query};
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR,
+      has_ray_query ? static_cast<void*>(&ray_query) : static_cast<void*>(&pipeline)};
   as_features.accelerationStructure = VK_TRUE;
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as_features};
   v12.bufferDeviceAddress = VK_TRUE;
   const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME};
+                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
+                              has_ray_query ? VK_KHR_RAY_QUERY_EXTENSION_NAME
+                                            : VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME};
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;

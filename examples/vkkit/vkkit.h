@@ -11,6 +11,7 @@
 namespace vkkit {
 
 void Check(VkResult result, const char* what);
+bool HasDeviceExtension(VkPhysicalDevice gpu, const char* name);
 
 struct InstanceOptions {
   std::vector<std::string> layers;             // enabled in this order (first = closest to the app)
