@@ -66,6 +66,14 @@ int main(int argc, char** argv) {
             o.threads = threads;
             row("asval_default", "bins16_leaf8", o);
         }
+        for (float budget : {0.0f, 0.1f, 0.4f}) {
+            BuildOptions o;
+            o.splitBudget = budget;
+            if (budget == 0) o.spatialSplits = SpatialSplits::Off;
+            char knobs[64];
+            std::snprintf(knobs, sizeof knobs, "bins16_leaf8_split%.2f", double(budget));
+            row("asval_sah", knobs, o);
+        }
         for (uint32_t bins : {4u, 8u, 32u, 64u}) {
             BuildOptions o;
             o.bins = bins;

@@ -59,10 +59,14 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(gdpa(device, "vkCreateAccelerationStructureKHR"));
   table->CreateBuffer = reinterpret_cast<PFN_vkCreateBuffer>(gdpa(device, "vkCreateBuffer"));
   table->CreateCommandPool = reinterpret_cast<PFN_vkCreateCommandPool>(gdpa(device, "vkCreateCommandPool"));
+  table->CreateQueryPool = reinterpret_cast<PFN_vkCreateQueryPool>(gdpa(device, "vkCreateQueryPool"));
+  table->DeferredOperationJoinKHR = reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(gdpa(device, "vkDeferredOperationJoinKHR"));
   table->DestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(gdpa(device, "vkDestroyAccelerationStructureKHR"));
   table->DestroyBuffer = reinterpret_cast<PFN_vkDestroyBuffer>(gdpa(device, "vkDestroyBuffer"));
   table->DestroyCommandPool = reinterpret_cast<PFN_vkDestroyCommandPool>(gdpa(device, "vkDestroyCommandPool"));
+  table->DestroyDeferredOperationKHR = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(gdpa(device, "vkDestroyDeferredOperationKHR"));
   table->DestroyDevice = reinterpret_cast<PFN_vkDestroyDevice>(gdpa(device, "vkDestroyDevice"));
+  table->DestroyQueryPool = reinterpret_cast<PFN_vkDestroyQueryPool>(gdpa(device, "vkDestroyQueryPool"));
   table->DeviceWaitIdle = reinterpret_cast<PFN_vkDeviceWaitIdle>(gdpa(device, "vkDeviceWaitIdle"));
   table->EndCommandBuffer = reinterpret_cast<PFN_vkEndCommandBuffer>(gdpa(device, "vkEndCommandBuffer"));
   table->FreeCommandBuffers = reinterpret_cast<PFN_vkFreeCommandBuffers>(gdpa(device, "vkFreeCommandBuffers"));
@@ -72,10 +76,12 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   static constexpr const char* kGetBufferDeviceAddressNames[] = {"vkGetBufferDeviceAddress", "vkGetBufferDeviceAddressEXT", "vkGetBufferDeviceAddressKHR"};
   table->GetBufferDeviceAddress = reinterpret_cast<PFN_vkGetBufferDeviceAddress>(LoadFirst(gdpa, device, kGetBufferDeviceAddressNames));
   table->GetBufferMemoryRequirements = reinterpret_cast<PFN_vkGetBufferMemoryRequirements>(gdpa(device, "vkGetBufferMemoryRequirements"));
+  table->GetDeferredOperationResultKHR = reinterpret_cast<PFN_vkGetDeferredOperationResultKHR>(gdpa(device, "vkGetDeferredOperationResultKHR"));
   table->GetDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(gdpa(device, "vkGetDeviceProcAddr"));
   table->GetDeviceQueue = reinterpret_cast<PFN_vkGetDeviceQueue>(gdpa(device, "vkGetDeviceQueue"));
   table->GetDeviceQueue2 = reinterpret_cast<PFN_vkGetDeviceQueue2>(gdpa(device, "vkGetDeviceQueue2"));
   table->GetFenceStatus = reinterpret_cast<PFN_vkGetFenceStatus>(gdpa(device, "vkGetFenceStatus"));
+  table->GetQueryPoolResults = reinterpret_cast<PFN_vkGetQueryPoolResults>(gdpa(device, "vkGetQueryPoolResults"));
   table->MapMemory = reinterpret_cast<PFN_vkMapMemory>(gdpa(device, "vkMapMemory"));
   table->QueueSubmit = reinterpret_cast<PFN_vkQueueSubmit>(gdpa(device, "vkQueueSubmit"));
   static constexpr const char* kQueueSubmit2Names[] = {"vkQueueSubmit2", "vkQueueSubmit2KHR"};

@@ -46,10 +46,14 @@ struct DeviceDispatchTable {
   PFN_vkCreateAccelerationStructureKHR CreateAccelerationStructureKHR = nullptr;
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
+  PFN_vkCreateQueryPool CreateQueryPool = nullptr;
+  PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
   PFN_vkDestroyAccelerationStructureKHR DestroyAccelerationStructureKHR = nullptr;
   PFN_vkDestroyBuffer DestroyBuffer = nullptr;
   PFN_vkDestroyCommandPool DestroyCommandPool = nullptr;
+  PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
   PFN_vkDestroyDevice DestroyDevice = nullptr;
+  PFN_vkDestroyQueryPool DestroyQueryPool = nullptr;
   PFN_vkDeviceWaitIdle DeviceWaitIdle = nullptr;
   PFN_vkEndCommandBuffer EndCommandBuffer = nullptr;
   PFN_vkFreeCommandBuffers FreeCommandBuffers = nullptr;
@@ -58,10 +62,12 @@ struct DeviceDispatchTable {
   PFN_vkGetAccelerationStructureDeviceAddressKHR GetAccelerationStructureDeviceAddressKHR = nullptr;
   PFN_vkGetBufferDeviceAddress GetBufferDeviceAddress = nullptr;
   PFN_vkGetBufferMemoryRequirements GetBufferMemoryRequirements = nullptr;
+  PFN_vkGetDeferredOperationResultKHR GetDeferredOperationResultKHR = nullptr;
   PFN_vkGetDeviceProcAddr GetDeviceProcAddr = nullptr;
   PFN_vkGetDeviceQueue GetDeviceQueue = nullptr;
   PFN_vkGetDeviceQueue2 GetDeviceQueue2 = nullptr;
   PFN_vkGetFenceStatus GetFenceStatus = nullptr;
+  PFN_vkGetQueryPoolResults GetQueryPoolResults = nullptr;
   PFN_vkMapMemory MapMemory = nullptr;
   PFN_vkQueueSubmit QueueSubmit = nullptr;
   PFN_vkQueueSubmit2 QueueSubmit2 = nullptr;

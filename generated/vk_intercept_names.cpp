@@ -6,47 +6,97 @@
 namespace asval::hooks {
 
 const char* const kInterceptNames[kInterceptNameCount] = {
+    "vkAllocateCommandBuffers",
     "vkAllocateMemory",
+    "vkBeginCommandBuffer",
     "vkBindBufferMemory",
     "vkBindBufferMemory2",
     "vkBindBufferMemory2KHR",
     "vkBuildAccelerationStructuresKHR",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
     "vkCmdBuildAccelerationStructuresKHR",
+    "vkCmdCopyAccelerationStructureKHR",
+    "vkCmdCopyAccelerationStructureToMemoryKHR",
+    "vkCmdCopyMemoryToAccelerationStructureKHR",
+    "vkCmdExecuteCommands",
+    "vkCmdWriteAccelerationStructuresPropertiesKHR",
+    "vkCopyAccelerationStructureKHR",
+    "vkCopyAccelerationStructureToMemoryKHR",
+    "vkCopyMemoryToAccelerationStructureKHR",
     "vkCreateAccelerationStructureKHR",
     "vkCreateBuffer",
+    "vkCreateCommandPool",
     "vkCreateDebugUtilsMessengerEXT",
     "vkCreateDevice",
     "vkCreateInstance",
+    "vkCreateQueryPool",
+    "vkDeferredOperationJoinKHR",
     "vkDestroyAccelerationStructureKHR",
     "vkDestroyBuffer",
+    "vkDestroyCommandPool",
     "vkDestroyDebugUtilsMessengerEXT",
+    "vkDestroyDeferredOperationKHR",
     "vkDestroyDevice",
     "vkDestroyInstance",
+    "vkDestroyQueryPool",
+    "vkFreeCommandBuffers",
     "vkFreeMemory",
+    "vkGetDeferredOperationResultKHR",
+    "vkGetQueryPoolResults",
+    "vkQueueSubmit",
+    "vkQueueSubmit2",
+    "vkQueueSubmit2KHR",
+    "vkResetCommandBuffer",
+    "vkResetCommandPool",
     "vkSetDebugUtilsObjectNameEXT",
+    "vkWriteAccelerationStructuresPropertiesKHR",
 };
 
 const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
+    true,  // vkAllocateCommandBuffers
     true,  // vkAllocateMemory
+    true,  // vkBeginCommandBuffer
     true,  // vkBindBufferMemory
     true,  // vkBindBufferMemory2
     true,  // vkBindBufferMemory2KHR
     true,  // vkBuildAccelerationStructuresKHR
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
     true,  // vkCmdBuildAccelerationStructuresKHR
+    true,  // vkCmdCopyAccelerationStructureKHR
+    true,  // vkCmdCopyAccelerationStructureToMemoryKHR
+    true,  // vkCmdCopyMemoryToAccelerationStructureKHR
+    true,  // vkCmdExecuteCommands
+    true,  // vkCmdWriteAccelerationStructuresPropertiesKHR
+    true,  // vkCopyAccelerationStructureKHR
+    true,  // vkCopyAccelerationStructureToMemoryKHR
+    true,  // vkCopyMemoryToAccelerationStructureKHR
     true,  // vkCreateAccelerationStructureKHR
     true,  // vkCreateBuffer
+    true,  // vkCreateCommandPool
     false,  // vkCreateDebugUtilsMessengerEXT
     false,  // vkCreateDevice
     false,  // vkCreateInstance
+    true,  // vkCreateQueryPool
+    true,  // vkDeferredOperationJoinKHR
     true,  // vkDestroyAccelerationStructureKHR
     true,  // vkDestroyBuffer
+    true,  // vkDestroyCommandPool
     false,  // vkDestroyDebugUtilsMessengerEXT
+    true,  // vkDestroyDeferredOperationKHR
     true,  // vkDestroyDevice
     false,  // vkDestroyInstance
+    true,  // vkDestroyQueryPool
+    true,  // vkFreeCommandBuffers
     true,  // vkFreeMemory
+    true,  // vkGetDeferredOperationResultKHR
+    true,  // vkGetQueryPoolResults
+    true,  // vkQueueSubmit
+    true,  // vkQueueSubmit2
+    true,  // vkQueueSubmit2KHR
+    true,  // vkResetCommandBuffer
+    true,  // vkResetCommandPool
     true,  // vkSetDebugUtilsObjectNameEXT
+    true,  // vkWriteAccelerationStructuresPropertiesKHR
 };
 
 int InterceptNameIndex(const char* name) {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "build_input_alignment.h"
+
 namespace asval {
 
 namespace {
@@ -42,6 +44,7 @@ bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.infos) return false;
   bool skip = false;
   if (!cmd.is_host()) skip |= ValidateScratchAlignment(ctx, cmd);
+  skip |= ValidateInputAlignment(ctx, cmd);
   return skip;
 }
 

@@ -8,6 +8,7 @@ namespace asval {
 // VUID-vkCmdBuildAccelerationStructures{,Indirect}KHR-pInfos-03710: each pInfos[i].scratchData.deviceAddress
 // is a multiple of minAccelerationStructureScratchOffsetAlignment (device builds only: host scratch is a
 // host pointer).
+// Then the alignment of the geometry inputs and of the indirect arrays (build_input_alignment.h).
 bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd);
 
 }  // namespace asval

@@ -1,6 +1,14 @@
 #include "build_validation.h"
 
+#include "build_addresses.h"
 #include "build_alignment.h"
+#include "build_aliasing.h"
+#include "build_features.h"
+#include "build_handles.h"
+#include "build_host.h"
+#include "build_ranges.h"
+#include "build_structure.h"
+#include "history_record.h"
 
 namespace asval {
 
@@ -14,7 +22,15 @@ struct BuildFamily {
 };
 
 constexpr BuildFamily kBuildFamilies[] = {
+    {kCheckFeatures, &ValidateBuildFeatures},
+    {kCheckHandles, &ValidateBuildHandles},
+    {kCheckStructure, &ValidateBuildStructure},
+    {kCheckStructure, &ValidateBuildRanges},
     {kCheckAlignment, &ValidateBuildAlignment},
+    {kCheckHistory, &ValidateBuildHistory},  // host builds only; device builds are checked at submission
+    {kCheckAddresses, &ValidateBuildAddresses},
+    {kCheckAliasing, &ValidateBuildAliasing},
+    {kCheckHost, &ValidateBuildHost},
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The acceleration-structure build commands: describe the call as a BuildCommand, run the enabled rule
 // families over it, then pass the call down unless the app's callback asked to skip it.
 #include "build_validation.h"
+#include "history_record.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
@@ -26,6 +27,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.ranges = ppBuildRangeInfos;
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
+  RecordDeviceBuild(data->state, data->instance->settings.enabled_checks, cmd);  // history: applied at submission
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
@@ -44,6 +46,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);
+  RecordDeviceBuild(data->state, data->instance->settings.enabled_checks, cmd);  // history: applied at submission
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
@@ -60,8 +63,11 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
   // Skipped by the app's callback: the build did not happen. VK_ERROR_VALIDATION_FAILED_EXT is what the
   // Khronos layer returns in that case.
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return VK_ERROR_VALIDATION_FAILED_EXT;
-  return data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos,
-                                                       ppBuildRangeInfos);
+  const VkResult result =
+      data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
+  // History: applied now on success, or when the deferred operation completes.
+  FinishHostBuild(data->state, data->instance->settings.enabled_checks, cmd, result);
+  return result;
 }
 
 }  // namespace asval::hooks

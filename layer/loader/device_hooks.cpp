@@ -1,5 +1,6 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include "history_record.h"
 #include "layer_data.h"
 #include "state_tracker.h"
 #include "vk_intercepts.h"
@@ -9,6 +10,7 @@ namespace asval::hooks {
 VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCallbacks* pAllocator) {
   if (!device) return;
   std::unique_ptr<DeviceData> data = Devices().Remove(GetDispatchKey(device));
+  if (data) ReportHistorySummary(data->state, *data->reporter, device);
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
 }
 
@@ -87,7 +89,10 @@ VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
                                                            VkAccelerationStructureKHR accelerationStructure,
                                                            const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
-  if (accelerationStructure) RecordDestroyAccelerationStructure(data->state, accelerationStructure);
+  if (accelerationStructure) {
+    RecordDestroyAccelerationStructure(data->state, accelerationStructure);
+    ForgetHistory(data->state, accelerationStructure);  // a new structure with this handle value starts fresh
+  }
   data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
 }
 

@@ -136,6 +136,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   InitDeviceDispatchTable(*pDevice, next_gdpa, &data->dispatch);
   data->state.features = ParseEnabledFeatures(*pCreateInfo);
   QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
+  data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);
+  data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));
   return VK_SUCCESS;
 }

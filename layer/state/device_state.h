@@ -8,7 +8,11 @@
 #include <memory>
 
 #include "address_map.h"
+#include "build_size_cache.h"
+#include "command_buffer_levels.h"
 #include "concurrent_map.h"
+#include "history_state.h"
+#include "format_features.h"
 #include "objects.h"
 
 namespace asval {
@@ -21,6 +25,8 @@ struct DeviceFeatures {
   bool buffer_device_address = false;
   bool ray_query = false;
   bool ray_tracing_pipeline = false;
+  // Not a feature, but read from the same create-info chain: VkDeviceGroupDeviceCreateInfo::physicalDeviceCount.
+  uint32_t physical_device_count = 1;
 };
 
 struct DeviceProperties {
@@ -40,6 +46,15 @@ class DeviceState {
   ConcurrentMap<VkAccelerationStructureKHR, std::shared_ptr<const AccelerationStructureState>> acceleration_structures;
   // Device addresses of buffers created with SHADER_DEVICE_ADDRESS usage, once bound.
   DeviceAddressMap buffer_addresses;
+
+  // Build history in execution order: command-buffer operation logs, histories, query pools (issue 6).
+  HistoryState history;
+  // vkGetAccelerationStructureBuildSizesKHR answers by build signature (the size and aliasing rules).
+  BuildSizeCache build_sizes;
+  // Command pools and buffers: level and protected-ness (commandBuffer-09547).
+  CommandBufferLevels command_buffer_levels;
+  // Buffer format features, asked of the driver once per format (vertexFormat-03797).
+  FormatFeatureCache format_features;
 
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.

@@ -14,6 +14,9 @@ struct MemoryState {
   uint32_t type_index = 0;
   VkMemoryPropertyFlags property_flags = 0;
   VkMemoryAllocateFlags allocate_flags = 0;  // from VkMemoryAllocateFlagsInfo (DEVICE_ADDRESS_BIT matters)
+  // Allocated with multiple instances (a device group): VkMemoryAllocateFlagsInfo::deviceMask with more than
+  // one bit, or, without DEVICE_MASK_BIT, a MULTI_INSTANCE heap on a device over several physical devices.
+  bool multi_instance = false;
 };
 
 struct BufferState {

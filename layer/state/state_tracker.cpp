@@ -26,8 +26,14 @@ void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, 
   if (info.memoryTypeIndex < state.properties.memory.memoryTypeCount) {
     record->property_flags = state.properties.memory.memoryTypes[info.memoryTypeIndex].propertyFlags;
   }
-  if (auto* flags = FindInChain<VkMemoryAllocateFlagsInfo>(info.pNext, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO)) {
-    record->allocate_flags = flags->flags;
+  auto* flags = FindInChain<VkMemoryAllocateFlagsInfo>(info.pNext, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+  if (flags) record->allocate_flags = flags->flags;
+  if (flags && (flags->flags & VK_MEMORY_ALLOCATE_DEVICE_MASK_BIT)) {
+    record->multi_instance = __builtin_popcount(flags->deviceMask) > 1;
+  } else if (info.memoryTypeIndex < state.properties.memory.memoryTypeCount) {
+    const uint32_t heap = state.properties.memory.memoryTypes[info.memoryTypeIndex].heapIndex;
+    record->multi_instance = state.features.physical_device_count > 1 && heap < state.properties.memory.memoryHeapCount &&
+                             (state.properties.memory.memoryHeaps[heap].flags & VK_MEMORY_HEAP_MULTI_INSTANCE_BIT);
   }
   state.memories.insert_or_assign(memory, std::move(record));
 }
@@ -120,6 +126,11 @@ DeviceFeatures ParseEnabledFeatures(const VkDeviceCreateInfo& info) {
       case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES:
         f.buffer_device_address |= reinterpret_cast<const VkPhysicalDeviceVulkan12Features*>(s)->bufferDeviceAddress;
         break;
+      case VK_STRUCTURE_TYPE_DEVICE_GROUP_DEVICE_CREATE_INFO: {
+        const uint32_t count = reinterpret_cast<const VkDeviceGroupDeviceCreateInfo*>(s)->physicalDeviceCount;
+        f.physical_device_count = count > 0 ? count : 1;
+        break;
+      }
       case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR:
         f.ray_query = reinterpret_cast<const VkPhysicalDeviceRayQueryFeaturesKHR*>(s)->rayQuery;
         break;

@@ -22,6 +22,7 @@ Report CheckTree(const asval::builder::Bvh& bvh, const std::vector<asval::builde
         if (!refsById.empty()) fail("empty tree for non-empty input");
         return r;
     }
+    const bool checkPrimitives = !refsById.empty();
     std::vector<uint32_t> seen(refsById.size(), 0);
     std::vector<std::pair<uint32_t, uint32_t>> stack = {{0, 1}};
     while (!stack.empty()) {
@@ -43,7 +44,7 @@ Report CheckTree(const asval::builder::Bvh& bvh, const std::vector<asval::builde
         } else {
             r.maxLeaf = std::max(r.maxLeaf, n.count);
             if (n.leftOrFirst + uint64_t(n.count) > bvh.primIds.size()) { fail("leaf range"); continue; }
-            for (uint32_t k = 0; k < n.count; ++k) {
+            for (uint32_t k = 0; k < n.count && checkPrimitives; ++k) {
                 const uint32_t id = bvh.primIds[n.leftOrFirst + k];
                 if (id >= refsById.size() || refsById[id].aux == kAbsent) { fail("unknown id"); continue; }
                 ++seen[id];

@@ -21,7 +21,8 @@ struct Report {
 };
 
 // Every node box free of NaN; every child box inside its parent; leaves <= maxLeaf; depth <= 64; every id
-// of `boxes` (indexed by id) referenced exactly once (when `exactlyOnce`) and inside its leaf's box.
+// of `refsById` referenced exactly once (when `exactlyOnce`) and inside its leaf's box. An empty
+// `refsById` checks the structure only (used after spatial splits, where pieces are smaller than the box).
 Report CheckTree(const asval::builder::Bvh& bvh, const std::vector<asval::builder::PrimRef>& refsById,
                  uint32_t maxLeaf, bool exactlyOnce);
 

@@ -128,3 +128,30 @@ TEST_CASE("record through ClassifyTriangles: index hash set for indexed geometry
     CHECK(CompareActivity(a, b, ch, 1).indexHashDiffers);
     CHECK(CompareActivity(a, b, ch, 1).changedCount == 0);
 }
+
+TEST_CASE("the classifier's chunked index hash equals the one-shot hash over the whole range", "[record][hash]") {
+    testsupport::Rng rng(3);
+    for (int trial = 0; trial < 12; ++trial) {
+        const uint32_t n = 1 + rng.Below(20000);
+        const int indexBytes = trial % 3 == 0 ? 1 : trial % 3 == 1 ? 2 : 4;
+        const VkIndexType type = indexBytes == 2 ? VK_INDEX_TYPE_UINT16 : indexBytes == 4 ? VK_INDEX_TYPE_UINT32 : VK_INDEX_TYPE_UINT8_EXT;
+        const uint32_t offset = uint32_t(indexBytes) * rng.Below(7);
+        std::vector<uint8_t> idx(offset + size_t(n) * 3 * size_t(indexBytes));
+        for (auto& b : idx) b = uint8_t(rng.Below(indexBytes == 1 ? 200 : 4));  // small values: indices < 1024
+        std::vector<float> v(3 * 70000, 1.0f);
+        TriangleGeometryView view;
+        view.vertexData = v.data();
+        view.vertexDataBytes = v.size() * 4;
+        view.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+        view.vertexStride = 12;
+        view.maxVertex = 69999;
+        view.indexType = type;
+        view.indexData = idx.data();
+        view.indexDataBytes = idx.size();
+        view.range = {n, offset, 0, 0};
+        ActivityRecord rec;
+        ClassifyTriangles(view, &rec, nullptr);
+        REQUIRE(rec.hasIndexHash);
+        CHECK(rec.indexHash == HashIndexBytes(idx.data() + offset, size_t(n) * 3 * size_t(indexBytes), uint64_t(indexBytes)));
+    }
+}

@@ -186,3 +186,44 @@ TEST_CASE("instances: the exact image of the BLAS box lies inside the stored box
     CHECK(inflationCount > trials / 20);
     CHECK(meanInflation <= 1e-3);
 }
+
+TEST_CASE("norm formats: the box holds the exact rational value c / K of every code", "[bounds][norm]") {
+    struct Case { VkFormat format; uint32_t bits; bool isSigned; };
+    const Case cases[] = {{VK_FORMAT_R16G16_SNORM, 16, true}, {VK_FORMAT_R8G8_SNORM, 8, true},
+                          {VK_FORMAT_R16G16_UNORM, 16, false}, {VK_FORMAT_R8G8_UNORM, 8, false},
+                          {VK_FORMAT_A2B10G10R10_UNORM_PACK32, 10, false}};
+    for (const Case& c : cases) {
+        const uint32_t codes = 1u << c.bits;
+        const uint32_t bytes = c.format == VK_FORMAT_A2B10G10R10_UNORM_PACK32 ? 4 : 2 * (c.bits / 8);
+        std::vector<uint8_t> v(size_t(codes) * 3 * bytes, 0);
+        for (uint32_t code = 0; code < codes; ++code)
+            for (uint32_t k = 0; k < 3; ++k) {
+                uint8_t* p = v.data() + (size_t(code) * 3 + k) * bytes;
+                testsupport::WriteComponent(c.format, p, 0, code);     // X = the code under test
+                testsupport::WriteComponent(c.format, p, 1, k * 5);    // Y differs per vertex
+            }
+        TriangleGeometryView view;
+        view.vertexData = v.data();
+        view.vertexDataBytes = v.size();
+        view.vertexFormat = c.format;
+        view.vertexStride = bytes;
+        view.maxVertex = codes * 3 - 1;
+        view.range.primitiveCount = codes;
+        BuildInput in;
+        AppendTriangles(view, true, 0, &in);  // degenerate (X shared, Z shared): kept with ALLOW_UPDATE
+        REQUIRE(in.refs.size() == codes);
+        const double k = c.isSigned ? double((1u << (c.bits - 1)) - 1) : double((1u << c.bits) - 1);
+        uint64_t bad = 0, tight = 0;
+        for (const PrimRef& r : in.refs) {
+            double code = double(r.id);
+            if (c.isSigned && code >= double(codes / 2)) code -= double(codes);
+            if (code < -k) code = -k;  // max(c / K, -1)
+            // lo * K <= code <= hi * K, evaluated exactly (float times a <= 16-bit integer fits in double).
+            bad += !(double(r.lo[0]) * k <= code && code <= double(r.hi[0]) * k);
+            tight += r.lo[0] == r.hi[0] || std::nextafter(r.lo[0], INFINITY) == r.hi[0];
+        }
+        INFO("format " << int(c.format));
+        CHECK(bad == 0);
+        CHECK(tight == codes);  // never wider than the two floats around the exact value
+    }
+}

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "asval/builder/bvh.h"
+#include "asval/builder/bvh_triangles.h"
 #include "bvh_checks.h"
 #include "scenes.h"
 #include "test_support.h"
@@ -46,11 +47,11 @@ TriangleGeometryView ViewOf(const std::vector<float>& v) {
 }
 
 const BuildOptions kModes[] = {
-    {BuildMode::BinnedSah, 16, 8, 10, SpatialSplits::Off, 0.25f, 1},
-    {BuildMode::BinnedSah, 16, 8, 10, SpatialSplits::Off, 0.25f, 2},
-    {BuildMode::Lbvh, 16, 8, 10, SpatialSplits::Off, 0.25f, 1},
-    {BuildMode::BinnedSah, 4, 1, 10, SpatialSplits::Off, 0.25f, 1},
-    {BuildMode::Lbvh, 16, 4, 21, SpatialSplits::Off, 0.25f, 1},
+    {BuildMode::BinnedSah, 16, 8, 10, SpatialSplits::Off, 0.25f, 4.0f, 1},
+    {BuildMode::BinnedSah, 16, 8, 10, SpatialSplits::Off, 0.25f, 4.0f, 2},
+    {BuildMode::Lbvh, 16, 8, 10, SpatialSplits::Off, 0.25f, 4.0f, 1},
+    {BuildMode::BinnedSah, 4, 1, 10, SpatialSplits::Off, 0.25f, 4.0f, 1},
+    {BuildMode::Lbvh, 16, 4, 21, SpatialSplits::Off, 0.25f, 4.0f, 1},
 };
 
 }  // namespace
@@ -84,6 +85,17 @@ TEST_CASE("output is identical across runs and at 1 and 2 threads", "[bvh][deter
     o.mode = BuildMode::Lbvh;
     const Built d = BuildFrom(scenes::View(s), o), e = BuildFrom(scenes::View(s), o);
     CHECK(std::memcmp(d.bvh.nodes.data(), e.bvh.nodes.data(), d.bvh.nodes.size() * sizeof(BvhNode)) == 0);
+    // With spatial splits (the clustered scene triggers them), at 1 and 2 threads.
+    const TriangleGeometryView view = scenes::View(s);
+    BuildOptions split;
+    split.threads = 1;
+    const Bvh f = BuildTriangleBvh(&view, 1, true, split);
+    split.threads = 2;
+    const Bvh g = BuildTriangleBvh(&view, 1, true, split);
+    CHECK(f.stats.usedSpatialSplits);
+    REQUIRE(f.nodes.size() == g.nodes.size());
+    CHECK(std::memcmp(f.nodes.data(), g.nodes.data(), f.nodes.size() * sizeof(BvhNode)) == 0);
+    CHECK(f.primIds == g.primIds);
 }
 
 TEST_CASE("T1/T2: inactive and undefined-NaN triangles stay out; no NaN reaches any node", "[bvh][T1][T2]") {

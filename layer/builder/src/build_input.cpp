@@ -1,4 +1,6 @@
 // Conservative primitive boxes for the BVH (see build_input.h).
+#include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -54,7 +56,7 @@ void Put(BuildInput* out, uint32_t id, const float lo[3], const float hi[3]) {
     for (int c = 0; c < 3; ++c) {
         r.lo[c] = lo[c];
         r.hi[c] = hi[c];
-        infinite |= std::isinf(lo[c]) || std::isinf(hi[c]);
+        infinite |= !(std::fabs(lo[c]) <= FLT_MAX) || !(std::fabs(hi[c]) <= FLT_MAX);  // no NaN reaches here
     }
     r.id = id;
     r.aux = 0;
@@ -87,9 +89,35 @@ void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_
     if (transformed)
         std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
     const auto* vb = static_cast<const uint8_t*>(view.vertexData);
-    const auto* ib = static_cast<const uint8_t*>(view.indexData) + (indexBytes ? view.range.primitiveOffset : 0);
+    // Only dereferenced for readable (kept) primitives; never offset a null pointer.
+    const auto* ib = indexBytes && view.indexData ? static_cast<const uint8_t*>(view.indexData) + view.range.primitiveOffset : nullptr;
     const uint64_t nonIndexedBase = uint64_t(view.range.primitiveOffset) + view.vertexStride * view.range.firstVertex;
     out->refs.reserve(out->refs.size() + n);
+    if (info.kind == ComponentKind::Float32 && info.componentCount >= 3 && !transformed) {
+        // Fast path (the common case): float vertices are exact, the box is their min / max.
+        for (uint32_t t = 0; t < n; ++t) {
+            if (!Keep(states[t], allowUpdate, out)) continue;
+            float v[3][3];
+            for (int k = 0; k < 3; ++k) {
+                uint64_t off;
+                if (indexBytes == 0) {
+                    off = nonIndexedBase + (3ull * t + uint64_t(k)) * view.vertexStride;
+                } else {
+                    const uint8_t* ip = ib + (3ull * t + uint64_t(k)) * uint64_t(indexBytes);
+                    const uint64_t idx = indexBytes == 1 ? ip[0] : indexBytes == 2 ? detail::LoadU16(ip) : detail::LoadU32(ip);
+                    off = (idx + view.range.firstVertex) * view.vertexStride;
+                }
+                std::memcpy(v[k], vb + off, 12);
+            }
+            float lo[3], hi[3];
+            for (int c = 0; c < 3; ++c) {
+                lo[c] = std::min(v[0][c], std::min(v[1][c], v[2][c]));
+                hi[c] = std::max(v[0][c], std::max(v[1][c], v[2][c]));
+            }
+            Put(out, idBase + t, lo, hi);
+        }
+        return;
+    }
     for (uint32_t t = 0; t < n; ++t) {
         if (!Keep(states[t], allowUpdate, out)) continue;
         float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

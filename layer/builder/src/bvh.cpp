@@ -11,18 +11,17 @@ void FillStats(Bvh& bvh) {
     BuildStats& s = bvh.stats;
     s.references = uint32_t(bvh.primIds.size());
     if (bvh.nodes.empty()) return;
-    std::vector<std::pair<uint32_t, uint32_t>> stack = {{0, 1}};  // (node, depth)
-    while (!stack.empty()) {
-        const auto [i, depth] = stack.back();
-        stack.pop_back();
+    // Both builders place children after their parent, so one forward pass propagates depths.
+    std::vector<uint8_t> depth(bvh.nodes.size(), 0);
+    depth[0] = 1;
+    for (size_t i = 0; i < bvh.nodes.size(); ++i) {
         const BvhNode& n = bvh.nodes[i];
-        s.maxDepth = std::max(s.maxDepth, depth);
+        s.maxDepth = std::max<uint32_t>(s.maxDepth, depth[i]);
         if (n.count != 0) {
             ++s.leaves;
             s.maxLeafSize = std::max(s.maxLeafSize, n.count);
         } else {
-            stack.push_back({n.leftOrFirst, depth + 1});
-            stack.push_back({n.leftOrFirst + 1, depth + 1});
+            depth[n.leftOrFirst] = depth[n.leftOrFirst + 1] = uint8_t(depth[i] + 1);
         }
     }
 }

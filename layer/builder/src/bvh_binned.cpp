@@ -81,6 +81,7 @@ public:
     void RunTask(Task* task) {
         task->nodes.emplace_back();
         Build(task, 0, task->range);
+        task->nodes.shrink_to_fit();  // finished tasks keep no growth slack: peak memory stays near the tree
     }
 
 private:
@@ -104,8 +105,8 @@ private:
             lo = _mm_min_ps(lo, LoadLo(ref));
             hi = _mm_max_ps(hi, LoadHi(ref));
             const __m128 c = Centroid(ref);
-            clo = _mm_min_ps(clo, c);
-            chi = _mm_max_ps(chi, c);
+            clo = MinKeep(clo, c);
+            chi = MaxKeep(chi, c);
         }
         Range ToRange(uint32_t b, uint32_t e, uint32_t depth) const { return Range{b, e, lo, hi, clo, chi, depth}; }
     };
@@ -186,22 +187,39 @@ private:
             return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, zero), maxBin));  // NaN -> 0
         };
 
-        Bin bins[3][kMaxBins];
-        uint32_t counts[3][kMaxBins] = {};
-        for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins_; ++k) bins[a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
-        for (uint32_t i = r.begin; i < r.end; ++i) {
-            const PrimRef& ref = refs_[i];
-            alignas(16) int32_t k[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(ref));
+        // Two bin sets, alternating by reference, so consecutive references landing in the same bin do not
+        // serialise on one memory location; merged before the sweep. Each reference's three bin indices are
+        // kept in its `aux` field for the partition pass.
+        Bin bins[2][3][kMaxBins];
+        uint32_t counts[2][3][kMaxBins] = {};
+        for (int s2 = 0; s2 < 2; ++s2)
+            for (int a = 0; a < 3; ++a)
+                for (uint32_t k = 0; k < bins_; ++k) bins[s2][a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+        auto binOne = [&](PrimRef& ref, int set) {
+            const __m128i ki = binOf(ref);
+            const uint32_t k[3] = {uint32_t(_mm_cvtsi128_si32(ki)), uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(ki, 4))),
+                                   uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(ki, 8)))};
             const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
             for (int a = 0; a < 3; ++a) {
-                Bin& b = bins[a][k[a]];
+                Bin& b = bins[set][a][k[a]];
                 b.lo = _mm_min_ps(b.lo, lo);
                 b.hi = _mm_max_ps(b.hi, hi);
-                ++counts[a][k[a]];
+                ++counts[set][a][k[a]];
             }
+            ref.aux = k[0] | k[1] << 8 | k[2] << 16;
+        };
+        uint32_t i = r.begin;
+        for (; i + 1 < r.end; i += 2) {
+            binOne(refs_[i], 0);
+            binOne(refs_[i + 1], 1);
         }
+        if (i < r.end) binOne(refs_[i], 0);
+        for (int a = 0; a < 3; ++a)
+            for (uint32_t k = 0; k < bins_; ++k) {
+                bins[0][a][k].lo = _mm_min_ps(bins[0][a][k].lo, bins[1][a][k].lo);
+                bins[0][a][k].hi = _mm_max_ps(bins[0][a][k].hi, bins[1][a][k].hi);
+                counts[0][a][k] += counts[1][a][k];
+            }
         int axis = -1;
         uint32_t splitBin = 0;
         *bestCost = INFINITY;
@@ -212,36 +230,30 @@ private:
             __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
             uint32_t n = 0;
             for (uint32_t k = bins_ - 1; k > 0; --k) {
-                lo = _mm_min_ps(lo, bins[a][k].lo);
-                hi = _mm_max_ps(hi, bins[a][k].hi);
-                n += counts[a][k];
+                lo = _mm_min_ps(lo, bins[0][a][k].lo);
+                hi = _mm_max_ps(hi, bins[0][a][k].hi);
+                n += counts[0][a][k];
                 rightArea[k] = HalfArea(lo, hi);
                 rightCount[k] = n;
             }
             lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
             n = 0;
             for (uint32_t k = 0; k + 1 < bins_; ++k) {
-                lo = _mm_min_ps(lo, bins[a][k].lo);
-                hi = _mm_max_ps(hi, bins[a][k].hi);
-                n += counts[a][k];
+                lo = _mm_min_ps(lo, bins[0][a][k].lo);
+                hi = _mm_max_ps(hi, bins[0][a][k].hi);
+                n += counts[0][a][k];
                 if (n == 0 || rightCount[k + 1] == 0) continue;
                 const double cost = HalfArea(lo, hi) * n + rightArea[k + 1] * rightCount[k + 1];
                 if (cost < *bestCost) { *bestCost = cost; axis = a; splitBin = k + 1; }
             }
         }
         if (axis < 0) return false;
-        // Partition by bin on `axis` (the same arithmetic as the binning pass, so the sides match the bins),
-        // measuring each side as its references are visited.
-        alignas(16) int32_t sel[4] = {0, 0, 0, 0};
-        sel[axis] = -1;
-        const __m128i axisMask = _mm_load_si128(reinterpret_cast<const __m128i*>(sel));
-        const __m128i split = _mm_set1_epi32(int32_t(splitBin));
-        auto isLeft = [&](const PrimRef& ref) {
-            const __m128i lt = _mm_and_si128(_mm_cmplt_epi32(binOf(ref), split), axisMask);
-            return _mm_movemask_epi8(lt) != 0;
-        };
+        // Partition by the bin index the binning pass stored, measuring each side as it is visited.
+        const unsigned shift = 8u * unsigned(axis);
+        auto isLeft = [&](const PrimRef& ref) { return ((ref.aux >> shift) & 0xFFu) < splitBin; };
         Side l, rr;
-        uint32_t i = r.begin, j = r.end;
+        i = r.begin;
+        uint32_t j = r.end;
         for (;;) {
             while (i < j && isLeft(refs_[i])) l.Add(refs_[i++]);
             while (i < j && !isLeft(refs_[j - 1])) rr.Add(refs_[--j]);
@@ -344,8 +356,8 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
             lo = _mm_min_ps(lo, LoadLo(ref));
             hi = _mm_max_ps(hi, LoadHi(ref));
             const __m128 c = Centroid(ref);
-            clo = _mm_min_ps(clo, c);
-            chi = _mm_max_ps(chi, c);
+            clo = MinKeep(clo, c);
+            chi = MaxKeep(chi, c);
         }
         r.begin = 0; r.end = uint32_t(refs.size());
         r.lo = lo; r.hi = hi; r.clo = clo; r.chi = chi; r.depth = 1;
@@ -359,11 +371,13 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
     queue.Work(run);
     for (auto& w : workers) w.join();
 
+    // The references are dead once their ids are out: free them before the node arrays are stitched.
+    bvh.primIds.resize(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) bvh.primIds[i] = refs[i].id;
+    std::vector<PrimRef>().swap(refs);
     bvh.nodes.reserve(CountNodes(root) + 1);
     bvh.nodes.resize(1);
     Stitch(root, 0, bvh.nodes);
-    bvh.primIds.resize(refs.size());
-    for (size_t i = 0; i < refs.size(); ++i) bvh.primIds[i] = refs[i].id;
     return bvh;
 }
 

@@ -14,13 +14,14 @@ namespace asval::builder::detail {
 inline __m128 LoadLo(const PrimRef& r) { return _mm_load_ps(r.lo); }  // lane 3 holds the id: ignored
 inline __m128 LoadHi(const PrimRef& r) { return _mm_load_ps(r.hi); }
 
-// Centroid with coordinates clamped to +-FLT_MAX, so infinite boxes still have a finite centroid.
-inline __m128 Centroid(const PrimRef& r) {
-    const __m128 big = _mm_set1_ps(FLT_MAX), small = _mm_set1_ps(-FLT_MAX), half = _mm_set1_ps(0.5f);
-    const __m128 lo = _mm_max_ps(_mm_min_ps(LoadLo(r), big), small);
-    const __m128 hi = _mm_max_ps(_mm_min_ps(LoadHi(r), big), small);
-    return _mm_add_ps(_mm_mul_ps(lo, half), _mm_mul_ps(hi, half));
-}
+// Twice the centroid (lo + hi): one add. Infinite or huge boxes give +-inf or NaN lanes; every consumer
+// tolerates that (min/max keep the running value on NaN, bin indices clamp, such axes fall back to
+// median splits), so the common finite case pays nothing for the rare one.
+inline __m128 Centroid(const PrimRef& r) { return _mm_add_ps(LoadLo(r), LoadHi(r)); }
+
+// Running min / max that ignore a NaN in `v` (SSE min/max return the second operand on NaN).
+inline __m128 MinKeep(__m128 acc, __m128 v) { return _mm_min_ps(v, acc); }
+inline __m128 MaxKeep(__m128 acc, __m128 v) { return _mm_max_ps(v, acc); }
 
 // Half surface area in double, coordinates clamped to +-FLT_MAX: finite for any non-NaN box; an empty
 // box (lo = +inf, hi = -inf) has area 0.

@@ -130,7 +130,7 @@ Bvh BuildLbvh(std::vector<PrimRef>& refs, const BuildOptions& options) {
         uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
             double q = (double(c[a]) - double(lo[a])) * scale[a];
-            q = q < 0 ? 0 : (q > cells ? cells : q);
+            q = q >= 0 ? (q > cells ? cells : q) : 0;  // NaN (from an infinite box) -> 0
             code |= Spread3(uint64_t(q)) << (2 - a);
         }
         keys[i] = {code, i, 0};
@@ -147,13 +147,24 @@ Bvh BuildLbvh(std::vector<PrimRef>& refs, const BuildOptions& options) {
     }
     std::vector<Keyed>().swap(tmp);
 
-    bvh.nodes.reserve(n);
+    // Gather the references into Morton order: the top-down pass then reads them sequentially.
+    {
+        std::vector<PrimRef> sortedRefs(n);
+        for (uint32_t i = 0; i < n; ++i) sortedRefs[i] = refs[keys[i].ref];
+        refs.swap(sortedRefs);
+    }
+    for (uint32_t i = 0; i < n; ++i) keys[i].ref = i;
+    // A binary tree over n references has at most 2n - 1 nodes: reserving that avoids regrowth copies
+    // (the dominant term of the peak); the unused tail is returned below only when it is large.
+    bvh.nodes.reserve(size_t(2) * n - 1);
     bvh.nodes.emplace_back();
     LbvhBuilder builder(refs, keys, std::clamp<uint32_t>(options.maxLeafSize, 1, 8), &bvh);
     builder.Build(0, 0, n, 1, 63);
-    bvh.nodes.shrink_to_fit();
+    std::vector<Keyed>().swap(keys);
     bvh.primIds.resize(n);
-    for (uint32_t i = 0; i < n; ++i) bvh.primIds[i] = refs[keys[i].ref].id;
+    for (uint32_t i = 0; i < n; ++i) bvh.primIds[i] = refs[i].id;
+    std::vector<PrimRef>().swap(refs);
+    if (bvh.nodes.size() < bvh.nodes.capacity() / 2) bvh.nodes.shrink_to_fit();
     return bvh;
 }
 

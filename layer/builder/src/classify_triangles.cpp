@@ -1,6 +1,8 @@
 // Triangle classification: the activity pass. One loop per (vertex format, index type), instantiated from
 // small traits so that the inner loop has no per-vertex switch. Hot path: no allocation except the
 // record's bitset (reused when large enough), no floating-point arithmetic before the NaN test.
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <cstring>
 #include <type_traits>
@@ -32,7 +34,25 @@ struct Fmt<ComponentKind::Float32, 32, HasZ> {
         const uint32_t x = LoadU32(p), y = LoadU32(p + 4), z = HasZ ? LoadU32(p + 8) : 0u;
         return {{F32Key(x), F32Key(y), F32Key(z)}, F32BitsNaN(x), F32BitsNaN(y) || F32BitsNaN(z)};
     }
+    static constexpr unsigned kLoadBytes = HasZ ? 16 : 8;
+    static __m128i Keys(const uint8_t* p, int* nanBits) {
+        __m128i v = HasZ ? _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), _mm_set_epi32(0, -1, -1, -1))
+                         : _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
+        const __m128i magnitude = _mm_and_si128(v, _mm_set1_epi32(0x7FFFFFFF));
+        *nanBits = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(magnitude, _mm_set1_epi32(0x7F800000))));
+        // -0 -> +0: clear the sign where the magnitude is zero.
+        const __m128i zero = _mm_cmpeq_epi32(magnitude, _mm_setzero_si128());
+        return _mm_andnot_si128(_mm_and_si128(zero, _mm_set1_epi32(int32_t(0x80000000u))), v);
+    }
 };
+
+// Loads the first 2 (HasZ: 3) 16-bit components into 32-bit lanes, zero-extended, other lanes 0.
+template <bool HasZ>
+inline __m128i Load16x3(const uint8_t* p) {
+    const __m128i v = HasZ ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)) : _mm_cvtsi32_si128(int32_t(LoadU32(p)));
+    const __m128i lanes = _mm_unpacklo_epi16(v, _mm_setzero_si128());
+    return HasZ ? _mm_and_si128(lanes, _mm_set_epi32(0, -1, -1, -1)) : lanes;
+}
 
 template <bool HasZ>
 struct Fmt<ComponentKind::Float16, 16, HasZ> {
@@ -40,6 +60,13 @@ struct Fmt<ComponentKind::Float16, 16, HasZ> {
     static VertexKeys Load(const uint8_t* p) {
         const uint32_t x = LoadU16(p), y = LoadU16(p + 2), z = HasZ ? LoadU16(p + 4) : 0u;
         return {{F16Key(x), F16Key(y), F16Key(z)}, F16BitsNaN(x), F16BitsNaN(y) || F16BitsNaN(z)};
+    }
+    static constexpr unsigned kLoadBytes = HasZ ? 8 : 4;
+    static __m128i Keys(const uint8_t* p, int* nanBits) {
+        const __m128i v = Load16x3<HasZ>(p);
+        const __m128i magnitude = _mm_and_si128(v, _mm_set1_epi32(0x7FFF));
+        *nanBits = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(magnitude, _mm_set1_epi32(0x7C00))));
+        return _mm_andnot_si128(_mm_cmpeq_epi32(magnitude, _mm_setzero_si128()), v);  // -0 -> 0
     }
 };
 
@@ -54,6 +81,21 @@ struct Fmt<ComponentKind::Snorm, Bits, HasZ> {
         return {{SnormKey(Code(p, 0), Bits), SnormKey(Code(p, 1), Bits), HasZ ? SnormKey(Code(p, 2), Bits) : 0u},
                 false, false};
     }
+    static constexpr unsigned kLoadBytes = Bits == 16 ? (HasZ ? 8 : 4) : 4;
+    static __m128i Keys(const uint8_t* p, int* nanBits) {
+        *nanBits = 0;
+        __m128i v16;  // sign-extended 16-bit codes in the low 64 bits
+        if constexpr (Bits == 16) {
+            v16 = HasZ ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)) : _mm_cvtsi32_si128(int32_t(LoadU32(p)));
+        } else {
+            const __m128i b = _mm_cvtsi32_si128(int32_t(HasZ ? LoadU32(p) : LoadU16(p)));
+            v16 = _mm_srai_epi16(_mm_unpacklo_epi8(b, b), 8);
+        }
+        // The clamp max(c, -(2^(b-1)-1)) makes the two codes of -1 one key (value equality).
+        v16 = _mm_max_epi16(v16, _mm_set1_epi16(int16_t(-((1 << (Bits - 1)) - 1))));
+        const __m128i lanes = _mm_unpacklo_epi16(v16, _mm_setzero_si128());  // key = 16-bit pattern
+        return _mm_and_si128(lanes, HasZ ? _mm_set_epi32(0, -1, -1, -1) : _mm_set_epi32(0, 0, -1, -1));
+    }
 };
 
 template <unsigned Bits, bool HasZ>
@@ -66,6 +108,17 @@ struct Fmt<ComponentKind::Unorm, Bits, HasZ> {
     static VertexKeys Load(const uint8_t* p) {
         return {{Code(p, 0), Code(p, 1), HasZ ? Code(p, 2) : 0u}, false, false};
     }
+    static constexpr unsigned kLoadBytes = Bits == 16 ? (HasZ ? 8 : 4) : 4;
+    static __m128i Keys(const uint8_t* p, int* nanBits) {
+        *nanBits = 0;
+        if constexpr (Bits == 16) {
+            return Load16x3<HasZ>(p);
+        } else {
+            const __m128i b = _mm_cvtsi32_si128(int32_t(HasZ ? LoadU32(p) : LoadU16(p)));
+            const __m128i lanes = _mm_unpacklo_epi16(_mm_unpacklo_epi8(b, _mm_setzero_si128()), _mm_setzero_si128());
+            return _mm_and_si128(lanes, HasZ ? _mm_set_epi32(0, -1, -1, -1) : _mm_set_epi32(0, 0, -1, -1));
+        }
+    }
 };
 
 template <bool HasZ>
@@ -74,6 +127,12 @@ struct Fmt<ComponentKind::Unorm1010102, 10, HasZ> {
     static VertexKeys Load(const uint8_t* p) {
         const uint32_t w = LoadU32(p);
         return {{w & 0x3FFu, (w >> 10) & 0x3FFu, (w >> 20) & 0x3FFu}, false, false};
+    }
+    static constexpr unsigned kLoadBytes = 4;
+    static __m128i Keys(const uint8_t* p, int* nanBits) {
+        *nanBits = 0;
+        const uint32_t w = LoadU32(p);
+        return _mm_set_epi32(0, int32_t((w >> 20) & 0x3FFu), int32_t((w >> 10) & 0x3FFu), int32_t(w & 0x3FFu));
     }
 };
 
@@ -85,6 +144,15 @@ inline bool DegenerateKeys(const VertexKeys& a, const VertexKeys& b, const Verte
     const bool same01 = sx01 & sy01 & sz01, same12 = sx12 & sy12 & sz12, same02 = sx02 & sy02 & sz02;
     const int axes = int(sx01 & sx12) + int(sy01 & sy12) + int(sz01 & sz12);
     return same01 | same12 | same02 | (axes >= 2);
+}
+
+// The same definition on SIMD keys: lane masks of equal components per vertex pair.
+inline bool DegenerateSimd(__m128i a, __m128i b, __m128i c) {
+    const int m01 = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(a, b))) & 7;
+    const int m12 = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(b, c))) & 7;
+    const int m02 = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(a, c))) & 7;
+    // Axes shared by all three vertices: m01 & m12 (key equality is transitive); >= 2 of them: 0xE8 table.
+    return (m01 == 7) | (m12 == 7) | (m02 == 7) | ((0xE8 >> (m01 & m12)) & 1);
 }
 
 // Undefined-input triangles (NaN in Y/Z) take this path: value comparison on decoded floats, where NaN
@@ -123,11 +191,13 @@ struct LoopInput {
     const VertexFormatInfo* info;
     const uint8_t* vertices;
     uint64_t readableVertices;  // vertex v is readable iff v < readableVertices (indexed: from vertexData)
+    uint64_t availableBytes;    // bytes readable from `vertices` (for the wider SIMD loads)
     uint64_t stride;
     uint64_t maxVertex;
     uint64_t firstVertex;
     const uint8_t* indices;     // already advanced by primitiveOffset
     uint32_t count;             // triangles
+    uint32_t begin, end;        // the chunk this call classifies (begin % 64 == 0)
     uint32_t readableCount;     // triangles whose indices (or vertices, non-indexed) were provided
     uint64_t* bits;             // may be null
     uint8_t* states;            // may be null
@@ -136,19 +206,26 @@ struct LoopInput {
 template <typename F, typename IndexT>
 void ClassifyLoop(const LoopInput& in, Counters& out) {
     constexpr bool kIndexed = !std::is_same_v<IndexT, NoIndex>;
+    const uint64_t simdVertices =
+        std::min(in.readableVertices, in.availableBytes < F::kLoadBytes ? 0
+                                      : in.stride == 0 ? UINT64_MAX
+                                                       : (in.availableBytes - F::kLoadBytes) / in.stride + 1);
     uint64_t word = 0;
-    for (uint32_t t = 0; t < in.count; ++t) {
-        uint64_t v0, v1, v2;
+    for (uint32_t t = in.begin; t < in.end; ++t) {
+        uint64_t v0 = 0, v1 = 0, v2 = 0;
+        const bool indicesReadable = t < in.readableCount;  // checked before any index is loaded
         if constexpr (kIndexed) {
-            v0 = LoadIndex<IndexT>(in.indices, 3ull * t) + in.firstVertex;
-            v1 = LoadIndex<IndexT>(in.indices, 3ull * t + 1) + in.firstVertex;
-            v2 = LoadIndex<IndexT>(in.indices, 3ull * t + 2) + in.firstVertex;
+            if (__builtin_expect(indicesReadable, 1)) {
+                v0 = LoadIndex<IndexT>(in.indices, 3ull * t) + in.firstVertex;
+                v1 = LoadIndex<IndexT>(in.indices, 3ull * t + 1) + in.firstVertex;
+                v2 = LoadIndex<IndexT>(in.indices, 3ull * t + 2) + in.firstVertex;
+            }
         } else {
             v0 = 3ull * t; v1 = v0 + 1; v2 = v0 + 2;
         }
         const uint64_t vmax = std::max(v0, std::max(v1, v2));
         uint8_t state;
-        if (__builtin_expect(t >= in.readableCount || vmax >= in.readableVertices, 0)) {
+        if (__builtin_expect(!indicesReadable || vmax >= in.readableVertices, 0)) {
             // Not provided: cannot be classified; recorded active so no update error is invented from it.
             state = kStateActive | kStateUnreadable;
             ++out.unreadable;
@@ -157,19 +234,32 @@ void ClassifyLoop(const LoopInput& in, Counters& out) {
             const uint8_t* p0 = in.vertices + v0 * in.stride;
             const uint8_t* p1 = in.vertices + v1 * in.stride;
             const uint8_t* p2 = in.vertices + v2 * in.stride;
-            const VertexKeys a = F::Load(p0), b = F::Load(p1), c = F::Load(p2);
-            const bool inactive = F::kHasNaN && (a.xNaN | b.xNaN | c.xNaN);
+            bool inactive, undefinedInput, degenerate = false;
+            __m128i ka, kb, kc;
+            const bool wide = vmax < simdVertices;  // the SIMD loads read kLoadBytes: only where provided
+            if (__builtin_expect(wide, 1)) {
+                int na, nb, nc;
+                ka = F::Keys(p0, &na);
+                kb = F::Keys(p1, &nb);
+                kc = F::Keys(p2, &nc);
+                const int nan = na | nb | nc;
+                inactive = F::kHasNaN && (nan & 1);
+                undefinedInput = F::kHasNaN && (nan & 6);
+            } else {
+                const VertexKeys a = F::Load(p0), b = F::Load(p1), c = F::Load(p2);
+                inactive = F::kHasNaN && (a.xNaN | b.xNaN | c.xNaN);
+                undefinedInput = F::kHasNaN && (a.yzNaN | b.yzNaN | c.yzNaN);
+                if (!inactive && !undefinedInput) degenerate = DegenerateKeys(a, b, c);
+            }
             if (inactive) {
                 state = 0;
             } else {
-                const bool undefinedInput = F::kHasNaN && (a.yzNaN | b.yzNaN | c.yzNaN);
-                bool degenerate;
                 if (__builtin_expect(undefinedInput, 0)) {
                     degenerate = DegenerateDecoded(*in.info, p0, p1, p2);
                     ++out.undefinedNaN;
                     if (out.firstUndefined == UINT32_MAX) out.firstUndefined = t;
-                } else {
-                    degenerate = DegenerateKeys(a, b, c);
+                } else if (wide) {
+                    degenerate = DegenerateSimd(ka, kb, kc);
                 }
                 bool sameIndex = false;
                 if constexpr (kIndexed) sameIndex = (v0 == v1) | (v1 == v2) | (v0 == v2);
@@ -179,7 +269,7 @@ void ClassifyLoop(const LoopInput& in, Counters& out) {
                 out.sameIndex += sameIndex;
             }
         }
-        if (__builtin_expect(vmax > in.maxVertex, 0)) {
+        if (__builtin_expect(indicesReadable && vmax > in.maxVertex, 0)) {
             ++out.overMaxVertex;
             if (out.firstOverMaxVertex == UINT32_MAX) out.firstOverMaxVertex = t;
         }
@@ -192,7 +282,7 @@ void ClassifyLoop(const LoopInput& in, Counters& out) {
         }
         if (in.states) in.states[t] = state;
     }
-    if ((in.count & 63) != 0 && in.bits) in.bits[in.count >> 6] = word;
+    if (in.end == in.count && (in.count & 63) != 0 && in.bits) in.bits[in.count >> 6] = word;
 }
 
 using LoopFn = void (*)(const LoopInput&, Counters&);
@@ -279,6 +369,7 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
         const uint64_t base = uint64_t(view.range.primitiveOffset) + view.vertexStride * view.range.firstVertex;
         in.vertices = static_cast<const uint8_t*>(view.vertexData) + (base <= vertexBytes ? base : 0);
         in.readableVertices = ReadableElements(vertexBytes, base, info->vertexBytes, view.vertexStride);
+        in.availableBytes = base <= vertexBytes ? vertexBytes - base : 0;
         in.readableCount = n;
         // The loop sees vertex j of the range; it reads vertex firstVertex + j, so shift maxVertex (when
         // firstVertex already exceeds it, 0 makes every triangle count, as vmax >= 2).
@@ -286,6 +377,7 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
     } else {
         in.vertices = static_cast<const uint8_t*>(view.vertexData);
         in.readableVertices = ReadableElements(vertexBytes, 0, info->vertexBytes, view.vertexStride);
+        in.availableBytes = vertexBytes;
         in.firstVertex = view.range.firstVertex;
         const uint64_t off = view.range.primitiveOffset;
         const uint64_t indexAvail = view.indexData ? view.indexDataBytes : 0;
@@ -293,16 +385,33 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
         const uint64_t readable = off <= indexAvail ? (indexAvail - off) / triBytes : 0;
         in.readableCount = uint32_t(std::min<uint64_t>(readable, n));
         in.indices = static_cast<const uint8_t*>(view.indexData) + (off <= indexAvail ? off : 0);
-        if (record) {
-            record->hasIndexHash = true;
-            record->indexHash = HashIndexBytes(in.indices, size_t(in.readableCount) * triBytes, uint64_t(indexBytes));
-        }
         r.indexHashPartial = in.readableCount < n;
     }
     if (!in.vertices) in.readableVertices = 0;
 
+    // Chunks of 4096 triangles (a multiple of 64 bits and of the hash's 32-byte blocks for every index
+    // size): each chunk's indices are hashed right after they were classified, while still in cache.
+    constexpr uint32_t kChunk = 4096;
+    const bool hashing = record && indexBytes != 0;
+    IndexHasher hasher{uint64_t(indexBytes)};
+    const uint64_t hashBytes = hashing ? uint64_t(in.readableCount) * 3u * uint64_t(indexBytes) : 0;
     Counters c;
-    PickLoop(*info, indexBytes)(in, c);
+    const LoopFn loop = PickLoop(*info, indexBytes);
+    for (uint32_t begin = 0; begin < n; begin += kChunk) {
+        in.begin = begin;
+        in.end = n - begin > kChunk ? begin + kChunk : n;
+        loop(in, c);
+        if (hashing) {
+            const uint64_t from = uint64_t(begin) * 3u * uint64_t(indexBytes);
+            const uint64_t to = std::min<uint64_t>(uint64_t(in.end) * 3u * uint64_t(indexBytes), hashBytes);
+            if (to > from) hasher.Blocks(in.indices + from, size_t((to - from) & ~uint64_t(31)));
+        }
+    }
+    if (hashing) {
+        const uint64_t whole = hashBytes & ~uint64_t(31);
+        record->hasIndexHash = true;
+        record->indexHash = hasher.Finish(in.indices + whole, size_t(hashBytes - whole), hashBytes);
+    }
 
     r.active = c.active;
     r.inactive = n - c.active;

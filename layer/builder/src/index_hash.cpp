@@ -23,26 +23,44 @@ inline uint64_t Fmix(uint64_t k) {  // murmur3 finaliser
 
 }  // namespace
 
-Hash128 HashIndexBytes(const void* data, size_t bytes, uint64_t seed) {
+IndexHasher::IndexHasher(uint64_t seed)
+    : h_{seed ^ kPrime[0], seed + kPrime[1], Rotl(seed, 17) ^ kPrime[2], ~seed ^ kPrime[3]} {}
+
+void IndexHasher::Blocks(const void* data, size_t bytes) {
     const auto* p = static_cast<const uint8_t*>(data);
-    uint64_t h[4] = {seed ^ kPrime[0], seed + kPrime[1], Rotl(seed, 17) ^ kPrime[2], ~seed ^ kPrime[3]};
-    size_t i = 0;
+    uint64_t h0 = h_[0], h1 = h_[1], h2 = h_[2], h3 = h_[3];
     // Four independent dependency chains: throughput rather than one multiply latency per word.
-    for (; i + 32 <= bytes; i += 32) {
+    for (size_t i = 0; i + 32 <= bytes; i += 32) {
         uint64_t w[4];
         std::memcpy(w, p + i, 32);
-        for (int l = 0; l < 4; ++l) h[l] = Step(h[l], w[l], kPrime[l]);
+        h0 = Step(h0, w[0], kPrime[0]);
+        h1 = Step(h1, w[1], kPrime[1]);
+        h2 = Step(h2, w[2], kPrime[2]);
+        h3 = Step(h3, w[3], kPrime[3]);
     }
+    h_[0] = h0; h_[1] = h1; h_[2] = h2; h_[3] = h3;
+}
+
+Hash128 IndexHasher::Finish(const void* tail, size_t tailBytes, uint64_t totalBytes) {
+    const auto* p = static_cast<const uint8_t*>(tail);
+    uint64_t h[4] = {h_[0], h_[1], h_[2], h_[3]};
     // Tail: zero-padded words; the length goes into the finalisation, so padding cannot collide.
-    for (int l = 0; i < bytes; ++l, i += 8) {
+    size_t i = 0;
+    for (int l = 0; i < tailBytes; ++l, i += 8) {
         uint64_t w = 0;
-        std::memcpy(&w, p + i, bytes - i < 8 ? bytes - i : 8);
+        std::memcpy(&w, p + i, tailBytes - i < 8 ? tailBytes - i : 8);
         h[l] = Step(h[l], w, kPrime[l]);
     }
-    const uint64_t len = uint64_t(bytes);
-    const uint64_t a = Fmix(h[0] ^ Rotl(h[2], 23) ^ len);
-    const uint64_t b = Fmix(h[1] ^ Rotl(h[3], 41) ^ (len * kPrime[0]));
+    const uint64_t a = Fmix(h[0] ^ Rotl(h[2], 23) ^ totalBytes);
+    const uint64_t b = Fmix(h[1] ^ Rotl(h[3], 41) ^ (totalBytes * kPrime[0]));
     return {Fmix(a + b), Fmix(b ^ Rotl(a, 32))};
+}
+
+Hash128 HashIndexBytes(const void* data, size_t bytes, uint64_t seed) {
+    IndexHasher h(seed);
+    const size_t whole = bytes & ~size_t(31);
+    h.Blocks(data, whole);
+    return h.Finish(static_cast<const uint8_t*>(data) + whole, bytes - whole, bytes);
 }
 
 }  // namespace asval::builder

@@ -30,7 +30,9 @@ struct BuildOptions {
     uint32_t maxLeafSize = 8;    // 1..8
     uint32_t mortonBitsPerAxis = 10;  // LBVH: 8..21
     SpatialSplits spatialSplits = SpatialSplits::Auto;
-    float splitBudget = 0.25f;   // extra references allowed by pre-splitting, as a fraction of the input
+    float splitBudget = 0.4f;    // extra references allowed by pre-splitting, as a fraction of the input
+    float splitFactor = 0.5f;    // once splitting is needed (Auto: largest box > 16x the mean box area),
+                                 // references whose box area exceeds splitFactor x the mean are cut
     uint32_t threads = 1;        // 1 or more; the output does not depend on it
 };
 

@@ -1,0 +1,72 @@
+#include "options.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <utility>
+
+#include "faults.h"
+
+namespace scene {
+
+namespace {
+
+bool ParseCount(const char* text, uint32_t min, uint32_t max, uint32_t* value) {
+  char* end = nullptr;
+  const unsigned long v = std::strtoul(text, &end, 10);
+  if (!*text || *end || v < min || v > max) return false;
+  *value = static_cast<uint32_t>(v);
+  return true;
+}
+
+bool Fail(std::string* error, std::string message) {
+  *error = std::move(message);
+  return false;
+}
+
+}  // namespace
+
+const char* Usage() {
+  return "usage: asval_scene [--frames N] [--instances N] [--size WxH] [--out FILE.png] [--inject FAULT]\n"
+         "       asval_scene --list-faults\n"
+         "Renders an animated ray-traced scene without a window (any device with VK_KHR_acceleration_structure\n"
+         "and VK_KHR_ray_tracing_pipeline). Layers come from the environment (VK_INSTANCE_LAYERS).\n"
+         "  --frames N      frames to render (default 4)\n"
+         "  --instances N   instances in the top-level structure, the ground included (default 2000)\n"
+         "  --size WxH      image size (default 256x256)\n"
+         "  --out FILE      write the last frame as PNG\n"
+         "  --inject FAULT  after the frames, commit one rule violation (see --list-faults)\n"
+         "  --list-faults   print each fault with the VUID it must trigger\n";
+}
+
+bool ParseOptions(int argc, char** argv, SceneOptions* o, std::string* error) {
+  for (int i = 1; i < argc; ++i) {
+    const char* a = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (std::strcmp(a, "--help") == 0 || std::strcmp(a, "-h") == 0) {
+      o->help = true;
+    } else if (std::strcmp(a, "--list-faults") == 0) {
+      o->list_faults = true;
+    } else if (std::strcmp(a, "--frames") == 0 && has_value) {
+      if (!ParseCount(argv[++i], 1, 100000, &o->frames)) return Fail(error, "--frames: expected 1..100000");
+    } else if (std::strcmp(a, "--instances") == 0 && has_value) {
+      if (!ParseCount(argv[++i], 2, 1000000, &o->instances)) return Fail(error, "--instances: expected 2..1000000");
+    } else if (std::strcmp(a, "--size") == 0 && has_value) {
+      const std::string s = argv[++i];
+      const size_t x = s.find('x');
+      if (x == std::string::npos || !ParseCount(s.substr(0, x).c_str(), 1, 8192, &o->width) ||
+          !ParseCount(s.substr(x + 1).c_str(), 1, 8192, &o->height)) {
+        return Fail(error, "--size: expected WxH, e.g. 256x256");
+      }
+    } else if (std::strcmp(a, "--out") == 0 && has_value) {
+      o->out = argv[++i];
+    } else if (std::strcmp(a, "--inject") == 0 && has_value) {
+      o->fault = FindFault(argv[++i]);
+      if (!o->fault) return Fail(error, std::string("--inject: unknown fault '") + argv[i] + "' (see --list-faults)");
+    } else {
+      return Fail(error, std::string("unknown or incomplete argument '") + a + "'");
+    }
+  }
+  return true;
+}
+
+}  // namespace scene

@@ -1,0 +1,25 @@
+#pragma once
+// The scene's command line.
+#include <cstdint>
+#include <string>
+
+namespace scene {
+
+struct FaultInfo;
+
+struct SceneOptions {
+  uint32_t frames = 4;
+  uint32_t instances = 2000;
+  uint32_t width = 256;
+  uint32_t height = 256;
+  std::string out;                   // PNG path; empty: no image written
+  const FaultInfo* fault = nullptr;  // --inject
+  bool list_faults = false;
+  bool help = false;
+};
+
+// Returns false (with a message in *error) on a malformed command line.
+bool ParseOptions(int argc, char** argv, SceneOptions* options, std::string* error);
+const char* Usage();
+
+}  // namespace scene

@@ -1,0 +1,306 @@
+#include "build_aliasing.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "buffer_lookup.h"
+#include "build_report.h"
+#include "build_sizes.h"
+#include "host_instances.h"
+#include "structure_memory.h"
+
+namespace asval {
+
+namespace {
+
+// What a span of memory is to its info. The order matters only for naming pairs (lower kind first).
+enum class SpanKind : uint8_t { kDst, kSrc, kScratch, kReferenced };
+
+// Bytes one info accesses: [begin, end) of a VkDeviceMemory (space = its handle), or of the host's address
+// space (host builds' scratch; space = 0).
+struct AccessSpan {
+  uint64_t space;
+  VkDeviceSize begin;
+  VkDeviceSize end;
+  uint32_t info;
+  SpanKind kind;
+  bool host;
+  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
+};
+
+// Per-thread buffers, reused from call to call so that a steady stream of builds allocates nothing.
+struct Workspace {
+  std::vector<AccessSpan> spans;
+  std::vector<uint32_t> active;
+  std::vector<uint64_t> references;
+  std::vector<std::pair<uint64_t, uint32_t>> destinations;  // (handle, info), sorted
+};
+
+Workspace& ThreadWorkspace() {
+  thread_local Workspace workspace;
+  return workspace;
+}
+
+constexpr int kMaxFindingsPerCall = 16;  // enough to show the pattern; a flood helps nobody
+
+bool SameSpace(const AccessSpan& a, const AccessSpan& b) { return a.host == b.host && a.space == b.space; }
+
+// The rule two overlapping spans break, or null when their overlap is allowed. `a` is the span of the lower
+// kind (so pairs are named once).
+const char* RuleFor(const AccessSpan& a, const AccessSpan& b) {
+  const bool same_info = a.info == b.info;
+  switch (a.kind) {
+    case SpanKind::kDst:
+      switch (b.kind) {
+        case SpanKind::kDst:
+          return same_info ? nullptr : "dstAccelerationStructure-03702";
+        case SpanKind::kSrc:  // an info's own source: an in-place update (or pInfos-03668, checked apart)
+          return same_info ? nullptr : "dstAccelerationStructure-03701";
+        case SpanKind::kScratch:
+          return "dstAccelerationStructure-03703";
+        case SpanKind::kReferenced:
+          return same_info ? nullptr : "dstAccelerationStructure-03706";
+      }
+      return nullptr;
+    case SpanKind::kSrc:
+      return b.kind == SpanKind::kScratch ? "scratchData-03705" : nullptr;  // sources may share bytes
+    case SpanKind::kScratch:
+      return b.kind == SpanKind::kScratch && !same_info ? "scratchData-03704" : nullptr;
+    case SpanKind::kReferenced:
+      return nullptr;
+  }
+  return nullptr;
+}
+
+const char* KindName(SpanKind kind) {
+  switch (kind) {
+    case SpanKind::kDst:
+      return "dstAccelerationStructure";
+    case SpanKind::kSrc:
+      return "srcAccelerationStructure";
+    case SpanKind::kScratch:
+      return "scratchData";
+    case SpanKind::kReferenced:
+      return "a structure its instances reference";
+  }
+  return "";
+}
+
+std::string DescribeSpan(const AccessSpan& s) {
+  if (s.host) return fmt::format("host bytes [0x{:x}, 0x{:x})", s.begin, s.end);
+  return fmt::format("bytes [0x{:x}, 0x{:x}) of VkDeviceMemory 0x{:x}", s.begin, s.end, s.space);
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportOverlap(const CheckContext& ctx, const BuildCommand& cmd, const char* rule,
+                                                const AccessSpan& a, const AccessSpan& b) {
+  // The finding is about the span the rule is named after: a destination (0370x) or scratch (03704/05).
+  const bool scratch_rule = rule[0] == 's';
+  const AccessSpan& subject = scratch_rule && a.kind != SpanKind::kScratch ? b : a;
+  const AccessSpan& other = &subject == &a ? b : a;
+  const VkDeviceSize from = std::max(a.begin, b.begin);
+  const VkDeviceSize to = std::min(a.end, b.end);
+  std::string other_name = fmt::format("pInfos[{}].{}", other.info, KindName(other.kind));
+  if (other.kind == SpanKind::kReferenced) {
+    other_name = fmt::format("VkAccelerationStructureKHR 0x{:x}, which instances of pInfos[{}] reference",
+                             reinterpret_cast<uint64_t>(other.structure), other.info);
+  }
+  return ReportBuild(ctx, cmd, subject.info, rule,
+                     [&](std::string&) { return InfoLocation(cmd, subject.info).Field(KindName(subject.kind)); },
+                     "({}, as this command accesses it) overlaps {} ({}) by {} bytes: [0x{:x}, 0x{:x}).",
+                     DescribeSpan(subject), other_name, DescribeSpan(other), to - from, from, to);
+}
+
+// A structure's bytes this build accesses: `accessed` from its start, at most its size. False when the layer
+// does not know where they are (unknown structure or buffer, not bound).
+bool StructureSpan(const DeviceState& state, VkAccelerationStructureKHR handle, VkDeviceSize accessed, uint32_t info,
+                   SpanKind kind, AccessSpan* out) {
+  const std::optional<StructureMemory> memory = MemoryOfStructure(state, handle);
+  if (!memory || !memory->bound()) return false;
+  const VkDeviceSize begin = memory->memory_offset();
+  *out = AccessSpan{reinterpret_cast<uint64_t>(memory->buffer->memory), begin,
+                    SaturatingAdd(begin, std::min(accessed, memory->structure->size)), info, kind, false, handle};
+  return true;
+}
+
+bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, VkDeviceSize bytes, AccessSpan* out) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (cmd.is_host()) {
+    const auto address = reinterpret_cast<uint64_t>(info.scratchData.hostAddress);
+    if (address == 0) return false;
+    *out = AccessSpan{0, address, SaturatingAdd(address, bytes), i, SpanKind::kScratch, true, VK_NULL_HANDLE};
+    return true;
+  }
+  const VkDeviceAddress address = info.scratchData.deviceAddress;
+  const std::optional<AddressHit> hit = FindBufferHolding(state, address, bytes, 0);
+  if (!hit) return false;  // not in one buffer: the addresses family reports it
+  const std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(hit->buffer);
+  if (!buffer || !*buffer || !(*buffer)->bound) return false;
+  const VkDeviceSize begin = (*buffer)->memory_offset + (address - hit->base);
+  *out = AccessSpan{reinterpret_cast<uint64_t>((*buffer)->memory), begin, SaturatingAdd(begin, bytes), i,
+                    SpanKind::kScratch, false, VK_NULL_HANDLE};
+  return true;
+}
+
+// The spans pInfos[i] accesses. Each one the layer cannot place is left out and counted.
+void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, Workspace& w) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
+  if (!sizes) return;  // counted by SizesOfInfo
+  const bool update = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+  AccessSpan span;
+  if (StructureSpan(ctx.state, info.dstAccelerationStructure, sizes->acceleration_structure_size, i, SpanKind::kDst,
+                    &span)) {
+    w.spans.push_back(span);
+  } else {
+    CountUnknownState(ctx);
+  }
+  if (update && info.srcAccelerationStructure != VK_NULL_HANDLE) {
+    if (StructureSpan(ctx.state, info.srcAccelerationStructure, sizes->acceleration_structure_size, i, SpanKind::kSrc,
+                      &span)) {
+      w.spans.push_back(span);
+    } else {
+      CountUnknownState(ctx);
+    }
+  }
+  const VkDeviceSize scratch = update ? sizes->update_scratch_size : sizes->build_scratch_size;
+  if (scratch != 0) {
+    if (ScratchSpan(ctx.state, cmd, i, scratch, &span)) {
+      w.spans.push_back(span);
+    } else {
+      CountUnknownState(ctx);
+    }
+  }
+  if (!cmd.is_host()) return;
+  // Host builds: the structures the instances reference are read by this command (dstAccelerationStructure-03706).
+  for (uint32_t j = 0; j < info.geometryCount; ++j) {
+    w.references.clear();
+    if (!CollectInstanceReferences(cmd, i, j, w.references)) continue;
+    for (uint64_t reference : w.references) {
+      const auto handle = reinterpret_cast<VkAccelerationStructureKHR>(reference);
+      // The whole structure: which of its bytes the build reads is the driver's business.
+      if (StructureSpan(ctx.state, handle, ~VkDeviceSize{0}, i, SpanKind::kReferenced, &span)) w.spans.push_back(span);
+    }
+  }
+}
+
+// Sort by (space, begin), then sweep keeping the spans that reach past the current one's start: each pair
+// met is an overlap. With no overlaps the active list holds at most one span, so the sweep is linear.
+bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
+  std::sort(w.spans.begin(), w.spans.end(), [](const AccessSpan& x, const AccessSpan& y) {
+    if (x.host != y.host) return x.host < y.host;
+    if (x.space != y.space) return x.space < y.space;
+    if (x.begin != y.begin) return x.begin < y.begin;
+    return x.info < y.info;
+  });
+  bool skip = false;
+  int findings = 0;
+  w.active.clear();
+  for (uint32_t k = 0; k < w.spans.size(); ++k) {
+    const AccessSpan& s = w.spans[k];
+    if (s.begin >= s.end) continue;
+    size_t kept = 0;
+    for (uint32_t a : w.active) {
+      const AccessSpan& t = w.spans[a];
+      if (SameSpace(t, s) && t.end > s.begin) w.active[kept++] = a;
+    }
+    w.active.resize(kept);
+    for (uint32_t a : w.active) {
+      const AccessSpan& t = w.spans[a];
+      const bool t_first = t.kind <= s.kind;
+      const AccessSpan& lo = t_first ? t : s;
+      const AccessSpan& hi = t_first ? s : t;
+      if (const char* rule = RuleFor(lo, hi)) {
+        skip |= ReportOverlap(ctx, cmd, rule, lo, hi);
+        if (++findings >= kMaxFindingsPerCall) return skip;
+      }
+    }
+    w.active.push_back(k);
+  }
+  return skip;
+}
+
+// pInfos-03668: an update whose source and destination differ must not alias them at all (whole structures).
+[[gnu::cold, gnu::noinline]] bool ReportUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                       const AccessSpan& src, const AccessSpan& dst) {
+  return ReportBuild(ctx, cmd, i, "pInfos-03668",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
+                     "(VkAccelerationStructureKHR 0x{:x}, {}) and dstAccelerationStructure (VkAccelerationStructureKHR "
+                     "0x{:x}, {}) of this update are different structures whose memory overlaps.",
+                     reinterpret_cast<uint64_t>(src.structure), DescribeSpan(src),
+                     reinterpret_cast<uint64_t>(dst.structure), DescribeSpan(dst));
+}
+
+bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE ||
+      info.srcAccelerationStructure == info.dstAccelerationStructure) {
+    return false;
+  }
+  AccessSpan src, dst;
+  const VkDeviceSize whole = ~VkDeviceSize{0};
+  if (!StructureSpan(ctx.state, info.srcAccelerationStructure, whole, i, SpanKind::kSrc, &src) ||
+      !StructureSpan(ctx.state, info.dstAccelerationStructure, whole, i, SpanKind::kDst, &dst)) {
+    CountUnknownState(ctx);
+    return false;
+  }
+  if (!SameSpace(src, dst) || src.end <= dst.begin || dst.end <= src.begin) return false;
+  return ReportUpdateAliasing(ctx, cmd, i, src, dst);
+}
+
+// None-03407 (host builds): no instance references another info's destination.
+[[gnu::cold, gnu::noinline]] bool ReportReferencedDestination(const CheckContext& ctx, const BuildCommand& cmd,
+                                                              uint32_t k, uint32_t j, uint32_t i, uint64_t reference) {
+  const uint32_t instance = FirstInstanceReferencing(cmd, k, j, reference);
+  return ReportBuild(ctx, cmd, k, "None-03407",
+                     [&](std::string&) {
+                       return GeometryLocation(cmd, k, j).Field("geometry").Field("instances").Field("data").Field(
+                           "hostAddress");
+                     },
+                     "(instance {}) references VkAccelerationStructureKHR 0x{:x}, which is pInfos[{}]."
+                     "dstAccelerationStructure of this same command.",
+                     instance, reference, i);
+}
+
+bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
+  w.destinations.clear();
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    w.destinations.emplace_back(reinterpret_cast<uint64_t>(cmd.infos[i].dstAccelerationStructure), i);
+  }
+  std::sort(w.destinations.begin(), w.destinations.end());
+  bool skip = false;
+  for (uint32_t k = 0; k < cmd.info_count; ++k) {
+    if (cmd.infos[k].type != VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) continue;
+    for (uint32_t j = 0; j < cmd.infos[k].geometryCount; ++j) {
+      w.references.clear();
+      if (!CollectInstanceReferences(cmd, k, j, w.references)) continue;
+      for (uint64_t reference : w.references) {
+        auto it = std::lower_bound(w.destinations.begin(), w.destinations.end(), std::make_pair(reference, 0u));
+        for (; it != w.destinations.end() && it->first == reference; ++it) {
+          if (it->second != k) {
+            skip |= ReportReferencedDestination(ctx, cmd, k, j, it->second, reference);
+            break;
+          }
+        }
+      }
+    }
+  }
+  return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.infos) return false;
+  Workspace& w = ThreadWorkspace();
+  w.spans.clear();
+  bool skip = false;
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    CollectSpans(ctx, cmd, i, w);
+    skip |= ValidateUpdateAliasing(ctx, cmd, i);
+  }
+  skip |= SweepOverlaps(ctx, cmd, w);
+  if (cmd.is_host()) skip |= ValidateReferencedDestinations(ctx, cmd, w);
+  return skip;
+}
+
+}  // namespace asval

@@ -1,0 +1,24 @@
+#pragma once
+// Memory aliasing inside one build command (family "aliasing"), for all three commands:
+//   dstAccelerationStructure-03701   a destination overlaps the source of another info's update
+//   dstAccelerationStructure-03702   two infos' destinations overlap
+//   dstAccelerationStructure-03703   a destination overlaps any info's scratch (its own included)
+//   scratchData-03704                two infos' scratch overlap
+//   scratchData-03705                scratch overlaps any update's source (its own included)
+//   pInfos-03668                     an update's source and destination are one structure or do not alias
+//   host builds, whose instances are readable when called:
+//   None-03407                       an instance references another info's destination
+//   dstAccelerationStructure-03706   a destination overlaps a structure another info's instances reference
+// "The memory accessed by this command" is the bytes the build really touches: accelerationStructureSize of
+// a destination or source (at most the structure's size), buildScratchSize or updateScratchSize of scratch,
+// all as the driver reports them for this build. They are compared as VkDeviceMemory offsets, so two buffers
+// over one allocation alias. The spans are sorted and swept once: O(n log n) for n infos, no all-pairs loop.
+// In-place updates (src == dst) are valid: an info's destination and its own source may be the same bytes.
+#include "build_command.h"
+#include "check_context.h"
+
+namespace asval {
+
+bool ValidateBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd);
+
+}  // namespace asval

@@ -1,0 +1,150 @@
+#include "build_handles.h"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "build_report.h"
+#include "vk_enum_string.h"
+
+namespace asval {
+
+namespace {
+
+using AsRecord = std::shared_ptr<const AccelerationStructureState>;
+
+AsRecord FindStructure(const CheckContext& ctx, VkAccelerationStructureKHR handle) {
+  if (handle == VK_NULL_HANDLE) return nullptr;
+  std::optional<AsRecord> record = ctx.state.acceleration_structures.find(handle);
+  return record ? std::move(*record) : nullptr;
+}
+
+// pInfos-03699 / 03700: the build's type against the type the destination was created with.
+bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                             const AccelerationStructureState& dst) {
+  const VkAccelerationStructureTypeKHR type = cmd.infos[i].type;
+  const char* vuid = nullptr;
+  if (type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+    vuid = "pInfos-03699";
+  } else if (type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) {
+    vuid = "pInfos-03700";
+  } else {
+    return false;  // GENERIC is a structure rule of its own (type-03654)
+  }
+  if (dst.type == type || dst.type == VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) return false;
+  return ReportBuild(ctx, cmd, i, vuid,
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
+                     "(0x{:x}) was created with VkAccelerationStructureCreateInfoKHR::type {}, but pInfos[{}].type is "
+                     "{}: it must have been created with that type or VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR.",
+                     reinterpret_cast<uint64_t>(dst.handle), string_VkAccelerationStructureTypeKHR(dst.type), i,
+                     string_VkAccelerationStructureTypeKHR(type));
+}
+
+// pInfos-03707 / 03708: the structure's buffer is bound. Unknown buffers and sparse buffers (bound through
+// vkQueueBindSparse, which the layer does not follow) are skipped and counted.
+bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const AccelerationStructureState& as,
+                   const char* vuid, const char* field) {
+  const std::optional<std::shared_ptr<const BufferState>> buffer = ctx.state.buffers.find(as.buffer);
+  if (!buffer || !*buffer || ((*buffer)->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
+    CountUnknownState(ctx);
+    return false;
+  }
+  if ((*buffer)->bound) return false;
+  return ReportBuild(ctx, cmd, i, vuid, [&](std::string&) { return InfoLocation(cmd, i).Field(field); },
+                     "(0x{:x}) was created on VkBuffer 0x{:x}, which is not bound to device memory (no "
+                     "vkBindBufferMemory or vkBindBufferMemory2 for it succeeded).",
+                     reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
+}
+
+bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  bool skip = false;
+  const AsRecord dst = FindStructure(ctx, info.dstAccelerationStructure);
+  if (!dst) {
+    skip |= ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
+                        [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
+                        "(0x{:x}) is not a valid VkAccelerationStructureKHR: {}.",
+                        reinterpret_cast<uint64_t>(info.dstAccelerationStructure),
+                        info.dstAccelerationStructure ? "no live acceleration structure of this device has this handle"
+                                                      : "it is VK_NULL_HANDLE");
+  } else {
+    skip |= ValidateDestinationType(ctx, cmd, i, *dst);
+    if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
+  }
+  if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
+    const AsRecord src = FindStructure(ctx, info.srcAccelerationStructure);
+    if (!src) {
+      skip |= ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
+                          [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
+                          "(0x{:x}) is not VK_NULL_HANDLE and not a valid VkAccelerationStructureKHR: no live "
+                          "acceleration structure of this device has this handle.",
+                          reinterpret_cast<uint64_t>(info.srcAccelerationStructure));
+    } else if (!cmd.is_host() && info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
+      skip |= ValidateBound(ctx, cmd, i, *src, "pInfos-03708", "srcAccelerationStructure");
+    }
+  }
+  return skip;
+}
+
+// A destination handle and the index of its info, sorted by handle.
+using DstEntry = std::pair<VkAccelerationStructureKHR, uint32_t>;
+
+[[gnu::cold, gnu::noinline]] bool ReportSharedDestination(const CheckContext& ctx, const BuildCommand& cmd,
+                                                          uint32_t first, uint32_t second) {
+  return ReportBuild(ctx, cmd, second, "dstAccelerationStructure-03698",
+                     [&](std::string&) { return InfoLocation(cmd, second).Field("dstAccelerationStructure"); },
+                     "(0x{:x}) is also the dstAccelerationStructure of pInfos[{}]: one command must not build the "
+                     "same acceleration structure twice.",
+                     reinterpret_cast<uint64_t>(cmd.infos[second].dstAccelerationStructure), first);
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportSourceIsOtherDestination(const CheckContext& ctx, const BuildCommand& cmd,
+                                                                 uint32_t i, uint32_t other) {
+  return ReportBuild(ctx, cmd, i, "pInfos-03403",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
+                     "(0x{:x}) is the dstAccelerationStructure of pInfos[{}]: a structure one info reads must not be "
+                     "written by another info of the same command (an in-place update names it as its own source "
+                     "and destination, in one info).",
+                     reinterpret_cast<uint64_t>(cmd.infos[i].srcAccelerationStructure), other);
+}
+
+// dstAccelerationStructure-03698 and pInfos-03403, by sorting the destinations once.
+bool ValidateDistinctHandles(const CheckContext& ctx, const BuildCommand& cmd) {
+  thread_local std::vector<DstEntry> sorted;  // reused: no allocation once it has grown
+  sorted.clear();
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    if (cmd.infos[i].dstAccelerationStructure) sorted.emplace_back(cmd.infos[i].dstAccelerationStructure, i);
+  }
+  std::sort(sorted.begin(), sorted.end());
+  bool skip = false;
+  for (size_t k = 1; k < sorted.size(); ++k) {
+    if (sorted[k].first != sorted[k - 1].first) continue;
+    // Report each later info against the first of its run (lowest index: the pairs are sorted).
+    size_t first = k - 1;
+    while (first > 0 && sorted[first - 1].first == sorted[k].first) --first;
+    skip |= ReportSharedDestination(ctx, cmd, sorted[first].second, sorted[k].second);
+  }
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureKHR src = cmd.infos[i].srcAccelerationStructure;
+    if (!src) continue;
+    auto it = std::lower_bound(sorted.begin(), sorted.end(), DstEntry{src, 0});
+    for (; it != sorted.end() && it->first == src; ++it) {
+      if (it->second == i) continue;  // the same info: an in-place update
+      skip |= ReportSourceIsOtherDestination(ctx, cmd, i, it->second);
+      break;  // once per source
+    }
+  }
+  return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.infos) return false;
+  bool skip = false;
+  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i);
+  if (cmd.info_count > 1) skip |= ValidateDistinctHandles(ctx, cmd);
+  return skip;
+}
+
+}  // namespace asval

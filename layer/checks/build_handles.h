@@ -1,0 +1,20 @@
+#pragma once
+// Handles and types of the acceleration-structure build commands (family "handles"):
+//   srcAccelerationStructure-04629   a non-null srcAccelerationStructure is a live structure of this device
+//   dstAccelerationStructure-03800   dstAccelerationStructure is a live structure of this device
+//   pInfos-03699 / 03700             a top-level (bottom-level) build writes a structure created top-level
+//                                    (bottom-level) or generic
+//   dstAccelerationStructure-03698   no two infos share a destination
+//   pInfos-03403                     no info's source is another info's destination
+//   pInfos-03707 / 03708             device builds: the buffer behind the destination (and, for updates, the
+//                                    source) is bound to memory
+// The duplicate rules sort the handles (O(n log n)) in a per-thread buffer that is reused, so a steady
+// stream of many-info calls allocates nothing.
+#include "build_command.h"
+#include "check_context.h"
+
+namespace asval {
+
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd);
+
+}  // namespace asval

@@ -1,0 +1,214 @@
+#include "build_host.h"
+
+#include <vector>
+
+#include "build_report.h"
+#include "build_sizes.h"
+#include "history_record.h"
+#include "host_instances.h"
+#include "structure_memory.h"
+#include "vk_enum_string.h"
+
+namespace asval {
+
+namespace {
+
+// The rules a structure's memory must meet in a host build, by the role the structure plays.
+struct StructureRole {
+  const char* host_visible_rule;
+  const char* multi_instance_rule;
+};
+constexpr StructureRole kDestination = {"pInfos-03722", "pInfos-03775"};
+constexpr StructureRole kSource = {"pInfos-03723", "pInfos-03776"};
+constexpr StructureRole kReferenced = {"pInfos-03724", "pInfos-03777"};
+
+// How a finding about a structure names it: a member of pInfos[i], or an instance of geometry j.
+struct StructurePlace {
+  uint32_t info;
+  const char* member;  // "dstAccelerationStructure", "srcAccelerationStructure", or null for an instance
+  uint32_t geometry;
+};
+
+Location PlaceLocation(const BuildCommand& cmd, const StructurePlace& place) {
+  if (place.member) return InfoLocation(cmd, place.info).Field(place.member);
+  return GeometryLocation(cmd, place.info, place.geometry).Field("geometry").Field("instances").Field("data").Field(
+      "hostAddress");
+}
+
+// "(instance k) references " for an instance's structure: the first instance that does (found when reporting).
+std::string PlacePrefix(const BuildCommand& cmd, const StructurePlace& place, VkAccelerationStructureKHR handle) {
+  if (place.member) return "";
+  const uint32_t k = FirstInstanceReferencing(cmd, place.info, place.geometry, reinterpret_cast<uint64_t>(handle));
+  return fmt::format("(instance {}) references ", k);
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportStructureMemory(const CheckContext& ctx, const BuildCommand& cmd,
+                                                        const StructurePlace& place, const char* rule,
+                                                        const StructureMemory& memory, const MemoryState& record,
+                                                        bool host_visible_rule) {
+  char properties[256];
+  string_VkMemoryPropertyFlags(record.property_flags, properties, sizeof(properties));
+  return ReportBuild(ctx, cmd, place.info, rule, [&](std::string&) { return PlaceLocation(cmd, place); },
+                     "{}VkAccelerationStructureKHR 0x{:x}, whose VkBuffer 0x{:x} is bound to VkDeviceMemory 0x{:x} "
+                     "{}.",
+                     PlacePrefix(cmd, place, memory.structure->handle),
+                     reinterpret_cast<uint64_t>(memory.structure->handle),
+                     reinterpret_cast<uint64_t>(memory.buffer->handle), reinterpret_cast<uint64_t>(record.handle),
+                     host_visible_rule
+                         ? fmt::format("of memory type {} ({}), which is not VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT",
+                                       record.type_index, properties)
+                         : std::string("allocated with multiple instances (a device group); a host build needs "
+                                       "memory of one instance"));
+}
+
+bool ValidateStructureMemory(const CheckContext& ctx, const BuildCommand& cmd, VkAccelerationStructureKHR handle,
+                             const StructurePlace& place, const StructureRole& role) {
+  const std::optional<StructureMemory> memory = MemoryOfStructure(ctx.state, handle);
+  if (!memory || !memory->bound()) {
+    CountUnknownState(ctx);  // not a live structure, or not bound: the handles family's rules
+    return false;
+  }
+  const std::optional<std::shared_ptr<const MemoryState>> record = ctx.state.memories.find(memory->buffer->memory);
+  if (!record || !*record) {
+    CountUnknownState(ctx);
+    return false;
+  }
+  bool skip = false;
+  if (!((*record)->property_flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+    skip |= ReportStructureMemory(ctx, cmd, place, role.host_visible_rule, *memory, **record, true);
+  }
+  if ((*record)->multi_instance) {
+    skip |= ReportStructureMemory(ctx, cmd, place, role.multi_instance_rule, *memory, **record, false);
+  }
+  return skip;
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportNullScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                    bool update, VkDeviceSize needed) {
+  return ReportBuild(ctx, cmd, i, update ? "pInfos-03726" : "pInfos-03725",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("scratchData").Field("hostAddress"); },
+                     "is NULL, but this {} needs {} bytes of scratch ({} reported by "
+                     "vkGetAccelerationStructureBuildSizesKHR for this geometry and these counts).",
+                     update ? "update" : "build", needed, update ? "updateScratchSize" : "buildScratchSize");
+}
+
+bool ValidateHostScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (info.scratchData.hostAddress != nullptr) return false;
+  const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
+  if (!sizes) return false;  // counted: without the size, a null pointer may be all a zero-size scratch needs
+  const bool update = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+  const VkDeviceSize needed = update ? sizes->update_scratch_size : sizes->build_scratch_size;
+  if (needed == 0) return false;
+  return ReportNullScratch(ctx, cmd, i, update, needed);
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportNullInput(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                  uint32_t j, const char* rule, const char* data_member,
+                                                  const char* field, uint32_t count) {
+  return ReportBuild(ctx, cmd, i, rule,
+                     [&](std::string&) {
+                       return GeometryLocation(cmd, i, j).Field("geometry").Field(data_member).Field(field).Field(
+                           "hostAddress");
+                     },
+                     "is NULL, but ppBuildRangeInfos[{}][{}].primitiveCount is {}: it must be a valid host address.",
+                     i, j, count);
+}
+
+bool ValidateInstanceReferences(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                                std::vector<uint64_t>& references) {
+  references.clear();
+  if (!CollectInstanceReferences(cmd, i, j, references)) return false;
+  bool skip = false;
+  const StructurePlace place{i, nullptr, j};
+  for (uint64_t reference : references) {
+    const auto handle = reinterpret_cast<VkAccelerationStructureKHR>(reference);
+    if (ctx.state.acceleration_structures.contains(handle)) {
+      skip |= ValidateStructureMemory(ctx, cmd, handle, place, kReferenced);
+      continue;
+    }
+    skip |= ReportBuild(ctx, cmd, i, "pInfos-03779", [&](std::string&) { return PlaceLocation(cmd, place); },
+                        "(instance {}) has accelerationStructureReference 0x{:x}, which is not a live "
+                        "VkAccelerationStructureKHR of this device.",
+                        FirstInstanceReferencing(cmd, i, j, reference), reference);
+  }
+  return skip;
+}
+
+bool ValidateHostInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                        std::vector<uint64_t>& references) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (!cmd.ranges || !cmd.ranges[i]) return false;
+  bool skip = false;
+  for (uint32_t j = 0; j < info.geometryCount; ++j) {
+    const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
+    if (!g) return skip;
+    const uint32_t count = cmd.ranges[i][j].primitiveCount;
+    if (count == 0) continue;  // builds nothing, reads nothing
+    switch (g->geometryType) {
+      case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
+        const VkAccelerationStructureGeometryTrianglesDataKHR& t = g->geometry.triangles;
+        if (!t.vertexData.hostAddress) {
+          skip |= ReportNullInput(ctx, cmd, i, j, "pInfos-03771", "triangles", "vertexData", count);
+        }
+        if (t.indexType != VK_INDEX_TYPE_NONE_KHR && !t.indexData.hostAddress) {
+          skip |= ReportNullInput(ctx, cmd, i, j, "pInfos-03772", "triangles", "indexData", count);
+        }
+        break;
+      }
+      case VK_GEOMETRY_TYPE_AABBS_KHR:
+        if (!g->geometry.aabbs.data.hostAddress) {
+          skip |= ReportNullInput(ctx, cmd, i, j, "pInfos-03774", "aabbs", "data", count);
+        }
+        break;
+      case VK_GEOMETRY_TYPE_INSTANCES_KHR:
+        if (!g->geometry.instances.data.hostAddress) {
+          skip |= ReportNullInput(ctx, cmd, i, j, "pInfos-03778", "instances", "data", count);
+        } else {
+          skip |= ValidateInstanceReferences(ctx, cmd, i, j, references);
+        }
+        break;
+      default:
+        break;
+    }
+  }
+  return skip;
+}
+
+// deferredOperation-03678. The layer knows an operation is still running when one of its host builds or
+// copies returned VK_OPERATION_DEFERRED_KHR and no join, result query or destroy has seen it complete since
+// (tracked by the history records while the history or copies family is on; else nothing is known).
+bool ValidateDeferredOperation(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (cmd.deferred_operation == VK_NULL_HANDLE) return false;
+  // HasDeferredOps only reads, under the history's own mutex; DeviceData owns the state as non-const.
+  if (!HasDeferredOps(const_cast<DeviceState&>(ctx.state), cmd.deferred_operation)) return false;
+  return ReportBuild(ctx, cmd, kNoInfo, "deferredOperation-03678",
+                     [&](std::string&) { return cmd.Root().Field("deferredOperation"); },
+                     "(VkDeferredOperationKHR 0x{:x}) is still associated with an earlier host command that returned "
+                     "VK_OPERATION_DEFERRED_KHR and has not been seen to complete (vkDeferredOperationJoinKHR "
+                     "returning VK_SUCCESS, or vkGetDeferredOperationResultKHR returning other than VK_NOT_READY).",
+                     reinterpret_cast<uint64_t>(cmd.deferred_operation));
+}
+
+}  // namespace
+
+bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.is_host() || !cmd.infos) return false;
+  thread_local std::vector<uint64_t> references;  // reused: instance references of one geometry
+  bool skip = ValidateDeferredOperation(ctx, cmd);
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+    skip |= ValidateStructureMemory(ctx, cmd, info.dstAccelerationStructure,
+                                    StructurePlace{i, "dstAccelerationStructure", 0}, kDestination);
+    if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR &&
+        info.srcAccelerationStructure != VK_NULL_HANDLE) {
+      skip |= ValidateStructureMemory(ctx, cmd, info.srcAccelerationStructure,
+                                      StructurePlace{i, "srcAccelerationStructure", 0}, kSource);
+    }
+    skip |= ValidateHostScratch(ctx, cmd, i);
+    skip |= ValidateHostInputs(ctx, cmd, i, references);
+  }
+  return skip;
+}
+
+}  // namespace asval

@@ -1,0 +1,20 @@
+#pragma once
+// Rules of vkBuildAccelerationStructuresKHR alone (family "host"):
+//   pInfos-03722 / 03723 / 03724   the destination, an update's source, and every structure an instance
+//                                  references are on buffers bound to host-visible memory
+//   pInfos-03775 / 03776 / 03777   ... to memory not allocated with multiple instances
+//   pInfos-03725 / 03726           scratchData.hostAddress is not null when the build (update) scratch size the
+//                                  driver reports for this build is not 0 (whether the bytes behind a non-null
+//                                  pointer are valid host memory cannot be known)
+//   pInfos-03771 / 03772 / 03774 / 03778   vertex, index, AABB and instance host addresses are not null for a
+//                                  geometry that builds primitives
+//   pInfos-03779                   each non-zero instance reference is a live acceleration structure
+//   deferredOperation-03678        the deferred operation has no earlier host command still running
+#include "build_command.h"
+#include "check_context.h"
+
+namespace asval {
+
+bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd);
+
+}  // namespace asval

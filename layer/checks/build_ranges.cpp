@@ -1,0 +1,161 @@
+#include "build_ranges.h"
+
+#include <cstring>
+
+#include "build_report.h"
+#include "vertex_format_alignment.h"
+#include "vk_enum_string.h"
+
+namespace asval {
+
+namespace {
+
+constexpr const char* kRangeVuid = "VUID-VkAccelerationStructureBuildRangeInfoKHR-";
+
+std::string RangeVuid(const char* suffix) { return std::string(kRangeVuid) + suffix; }
+
+// "ppBuildRangeInfos[i][j].<field>": a path element with two indices, built at report time.
+auto RangeField(const BuildCommand& cmd, uint32_t i, uint32_t j, const char* field) {
+  return [&cmd, i, j, field](std::string& storage) {
+    storage = fmt::format("ppBuildRangeInfos[{}][{}]", i, j);
+    return cmd.Root().Field(storage.c_str()).Field(field);
+  };
+}
+
+// The largest of `count` indices of `size` bytes at `data` (which need not be aligned).
+uint32_t LargestIndex(const uint8_t* data, uint64_t count, int size) {
+  uint32_t largest = 0;
+  if (size == 2) {
+    for (uint64_t k = 0; k < count; ++k) {
+      uint16_t index;
+      std::memcpy(&index, data + k * 2, sizeof(index));
+      if (index > largest) largest = index;
+    }
+  } else {
+    for (uint64_t k = 0; k < count; ++k) {
+      uint32_t index;
+      std::memcpy(&index, data + k * 4, sizeof(index));
+      if (index > largest) largest = index;
+    }
+  }
+  return largest;
+}
+
+// maxVertex-10774 for a host build: the indices are in host memory now, so the largest can be read.
+bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                                const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
+                                const VkAccelerationStructureBuildRangeInfoKHR& range, int index_size) {
+  if (range.primitiveCount == 0 || tri.indexData.hostAddress == nullptr) return false;
+  const auto* data = static_cast<const uint8_t*>(tri.indexData.hostAddress) + range.primitiveOffset;
+  const uint32_t largest = LargestIndex(data, uint64_t{range.primitiveCount} * 3, index_size);
+  if (uint64_t{range.firstVertex} + largest <= tri.maxVertex) return false;
+  return ReportBuild(ctx, cmd, i, RangeVuid("maxVertex-10774"),
+                     [&](std::string&) {
+                       return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
+                     },
+                     "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) plus the largest index the "
+                     "build reads ({}, among the {} {} indices at indexData.hostAddress + primitiveOffset {}).",
+                     tri.maxVertex, i, j, range.firstVertex, largest, uint64_t{range.primitiveCount} * 3,
+                     string_VkIndexType(tri.indexType), range.primitiveOffset);
+}
+
+bool ValidateNonIndexedRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                             const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
+                             const VkAccelerationStructureBuildRangeInfoKHR& range) {
+  bool skip = false;
+  const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
+  if (alignment.bytes == 0) {
+    CountUnknownState(ctx);
+  } else if (range.primitiveOffset % alignment.bytes != 0) {
+    skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03657"), RangeField(cmd, i, j, "primitiveOffset"),
+                        "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
+                        range.primitiveOffset, alignment.bytes,
+                        alignment.packed ? "size of the packed format" : "component size",
+                        string_VkFormat(tri.vertexFormat));
+  }
+  // Nothing is read when there are no triangles (firstVertex then names no vertex).
+  if (range.primitiveCount == 0) return skip;
+  const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
+  if (vertices > uint64_t{tri.maxVertex} + 1) {
+    skip |= ReportBuild(ctx, cmd, i, RangeVuid("vertexData-10418"), RangeField(cmd, i, j, "primitiveCount"),
+                        "({}) triangles consume {} vertices from vertexData, more than the geometry's maxVertex ({}) "
+                        "+ 1.",
+                        range.primitiveCount, vertices, tri.maxVertex);
+  }
+  if (uint64_t{range.firstVertex} + vertices - 1 > tri.maxVertex) {
+    skip |= ReportBuild(ctx, cmd, i, RangeVuid("None-10775"),
+                        [&](std::string&) {
+                          return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
+                        },
+                        "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) + primitiveCount ({}) * 3 - 1 "
+                        "= {}, the last vertex the non-indexed build reads.",
+                        tri.maxVertex, i, j, range.firstVertex, range.primitiveCount,
+                        uint64_t{range.firstVertex} + vertices - 1);
+  }
+  return skip;
+}
+
+bool ValidateTriangleRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                           const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
+                           const VkAccelerationStructureBuildRangeInfoKHR& range) {
+  bool skip = false;
+  const int index_size = IndexTypeSize(tri.indexType);
+  if (index_size == 0) {
+    skip |= ValidateNonIndexedRange(ctx, cmd, i, j, tri, range);
+  } else if (index_size == 2 || index_size == 4) {
+    if (range.primitiveOffset % index_size != 0) {
+      skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03656"), RangeField(cmd, i, j, "primitiveOffset"),
+                          "({}) is not a multiple of {}, the size of the geometry's indexType {}.",
+                          range.primitiveOffset, index_size, string_VkIndexType(tri.indexType));
+    } else if (cmd.is_host()) {
+      // Indices read from a misaligned offset are not the app's indices: only an aligned range is judged.
+      skip |= ValidateIndexedVertexCount(ctx, cmd, i, j, tri, range, index_size);
+    }
+  }
+  // Other index types are indexType-03798's finding; their ranges are not judged.
+  if (range.transformOffset % 16 != 0) {
+    skip |= ReportBuild(ctx, cmd, i, RangeVuid("transformOffset-03658"), RangeField(cmd, i, j, "transformOffset"),
+                        "({}) is not a multiple of 16.", range.transformOffset);
+  }
+  return skip;
+}
+
+bool ValidateRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                   const VkAccelerationStructureGeometryKHR& geometry,
+                   const VkAccelerationStructureBuildRangeInfoKHR& range) {
+  switch (geometry.geometryType) {
+    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
+      return ValidateTriangleRange(ctx, cmd, i, j, geometry.geometry.triangles, range);
+    case VK_GEOMETRY_TYPE_AABBS_KHR:
+      if (range.primitiveOffset % 8 == 0) return false;
+      return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03659"), RangeField(cmd, i, j, "primitiveOffset"),
+                         "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
+                         range.primitiveOffset);
+    case VK_GEOMETRY_TYPE_INSTANCES_KHR:
+      if (range.primitiveOffset % 16 == 0) return false;
+      return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03660"), RangeField(cmd, i, j, "primitiveOffset"),
+                         "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
+                         range.primitiveOffset);
+    default:
+      return false;  // geometry types of newer extensions have rules of their own
+  }
+}
+
+}  // namespace
+
+bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.infos || !cmd.ranges) return false;
+  bool skip = false;
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = cmd.ranges[i];
+    if (!ranges || !GeometriesWalkable(ctx, info)) continue;
+    for (uint32_t j = 0; j < info.geometryCount; ++j) {
+      const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
+      if (geometry) skip |= ValidateRange(ctx, cmd, i, j, *geometry, ranges[j]);
+    }
+  }
+  return skip;
+}
+
+}  // namespace asval

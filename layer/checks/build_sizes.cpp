@@ -1,0 +1,239 @@
+#include "build_sizes.h"
+
+#include <cstddef>
+
+#include "build_report.h"
+#include "vk_enum_string.h"
+
+namespace asval {
+
+namespace {
+
+// Build flags of VK_KHR_acceleration_structure itself. Other bits belong to extensions (motion blur,
+// micromaps, newer ones) whose features and structures the size query would also need: the layer does not
+// ask about those builds.
+constexpr VkBuildAccelerationStructureFlagsKHR kCoreBuildFlags =
+    VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR |
+    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_LOW_MEMORY_BIT_KHR;
+constexpr VkBuildAccelerationStructureFlagsKHR kFastBoth =
+    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+constexpr VkGeometryFlagsKHR kCoreGeometryFlags =
+    VK_GEOMETRY_OPAQUE_BIT_KHR | VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR;
+constexpr VkDeviceSize kMaxStride = 0xffffffffull;
+
+// Component size of the vertex formats the query accepts; 0 for others. The device's format features
+// decide whether the format is usable at all.
+uint32_t VertexComponentBytes(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32B32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 4;
+    case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+    case VK_FORMAT_R16G16_SNORM:
+    case VK_FORMAT_R16G16B16A16_SNORM:
+    case VK_FORMAT_R16G16_UNORM:
+    case VK_FORMAT_R16G16B16A16_UNORM:
+      return 2;
+    case VK_FORMAT_R8G8_SNORM:
+    case VK_FORMAT_R8G8B8A8_SNORM:
+    case VK_FORMAT_R8G8_UNORM:
+    case VK_FORMAT_R8G8B8A8_UNORM:
+      return 1;
+    default:
+      return 0;
+  }
+}
+
+bool TrianglesQueryable(const DeviceState& state, const VkAccelerationStructureGeometryTrianglesDataKHR& t) {
+  if (t.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR || t.pNext) return false;
+  const uint32_t component = VertexComponentBytes(t.vertexFormat);
+  if (component == 0 || t.vertexStride % component != 0 || t.vertexStride > kMaxStride) return false;
+  if (t.indexType != VK_INDEX_TYPE_NONE_KHR && t.indexType != VK_INDEX_TYPE_UINT16 &&
+      t.indexType != VK_INDEX_TYPE_UINT32) {
+    return false;
+  }
+  const std::optional<VkFormatFeatureFlags> features = state.format_features.BufferFeatures(t.vertexFormat);
+  return features && (*features & VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR);
+}
+
+bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGeometryKHR* g,
+                       VkGeometryTypeKHR expected) {
+  if (!g || g->sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR || g->pNext) return false;
+  if (g->geometryType != expected || (g->flags & ~kCoreGeometryFlags) != 0) return false;
+  switch (g->geometryType) {
+    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
+      return TrianglesQueryable(state, g->geometry.triangles);
+    case VK_GEOMETRY_TYPE_AABBS_KHR: {
+      const VkAccelerationStructureGeometryAabbsDataKHR& a = g->geometry.aabbs;
+      return a.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR && !a.pNext &&
+             a.stride % 8 == 0 && a.stride <= kMaxStride;
+    }
+    case VK_GEOMETRY_TYPE_INSTANCES_KHR: {
+      const VkAccelerationStructureGeometryInstancesDataKHR& d = g->geometry.instances;
+      return d.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR && !d.pNext &&
+             (d.arrayOfPointers == VK_TRUE || d.arrayOfPointers == VK_FALSE);
+    }
+    default:
+      return false;
+  }
+}
+
+uint32_t InstanceGeometryCount(const BuildCommand& cmd, uint32_t i, uint32_t j) {
+  if (cmd.is_indirect()) return cmd.max_primitive_counts[i][j];
+  return cmd.ranges[i][j].primitiveCount;
+}
+
+// pInfos-03801: instance counts (primitive counts of instance geometries) within maxInstanceCount.
+[[gnu::cold, gnu::noinline]] bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                      uint32_t j, uint32_t count, uint64_t limit) {
+  return ReportBuild(ctx, cmd, i, "pInfos-03801",
+                     [&](std::string& storage) {
+                       if (cmd.is_indirect()) {
+                         storage = fmt::format("ppMaxPrimitiveCounts[{}][{}]", i, j);
+                       } else {
+                         storage = fmt::format("ppBuildRangeInfos[{}][{}].primitiveCount", i, j);
+                       }
+                       return cmd.Root().Field(storage.c_str());
+                     },
+                     "({}) is greater than VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxInstanceCount ({}); "
+                     "pInfos[{}].{}[{}] is a VK_GEOMETRY_TYPE_INSTANCES_KHR geometry.",
+                     count, limit, i, cmd.infos[i].pGeometries ? "pGeometries" : "ppGeometries", j);
+}
+
+bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (cmd.is_indirect() ? !cmd.max_primitive_counts || !cmd.max_primitive_counts[i] : !cmd.ranges || !cmd.ranges[i]) {
+    return false;  // counts not given: another rule's business
+  }
+  bool skip = false;
+  for (uint32_t j = 0; j < info.geometryCount; ++j) {
+    const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
+    if (!g || g->geometryType != VK_GEOMETRY_TYPE_INSTANCES_KHR) continue;
+    const uint64_t limit = ctx.state.properties.acceleration_structure.maxInstanceCount;
+    if (limit == 0) {
+      CountUnknownState(ctx);
+      continue;
+    }
+    const uint32_t count = InstanceGeometryCount(cmd, i, j);
+    if (count > limit) skip |= ReportInstanceCount(ctx, cmd, i, j, count, limit);
+  }
+  return skip;
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportDestinationTooSmall(const CheckContext& ctx, const BuildCommand& cmd,
+                                                            uint32_t i, VkDeviceSize created, VkDeviceSize needed) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  std::string counts;
+  for (uint32_t j = 0; j < info.geometryCount && j < 8; ++j) {
+    counts += fmt::format("{}{}", j ? ", " : "",
+                          cmd.is_indirect() ? cmd.max_primitive_counts[i][j] : cmd.ranges[i][j].primitiveCount);
+  }
+  if (info.geometryCount > 8) counts += ", ...";
+  return ReportBuild(ctx, cmd, i, cmd.is_indirect() ? "pInfos-03652" : "pInfos-10126",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
+                     "(VkAccelerationStructureKHR 0x{:x}) was created with size {}, but "
+                     "vkGetAccelerationStructureBuildSizesKHR reports accelerationStructureSize {} for this build "
+                     "({}, {} geometr{}, {} [{}]); it is {} bytes short.",
+                     reinterpret_cast<uint64_t>(info.dstAccelerationStructure), created, needed,
+                     string_VkAccelerationStructureTypeKHR(info.type), info.geometryCount,
+                     info.geometryCount == 1 ? "y" : "ies",
+                     cmd.is_indirect() ? "ppMaxPrimitiveCounts" : "primitive counts", counts, needed - created);
+}
+
+bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                             const std::optional<BuildSizes>& sizes) {
+  if (!sizes) return false;  // counted by SizesOfInfo
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  const std::optional<std::shared_ptr<const AccelerationStructureState>> dst =
+      ctx.state.acceleration_structures.find(info.dstAccelerationStructure);
+  if (!dst || !*dst) {
+    CountUnknownState(ctx);  // not a live structure: dstAccelerationStructure-03800 says so
+    return false;
+  }
+  if ((*dst)->size >= sizes->acceleration_structure_size) return false;
+  if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
+    // An update may write a compacted structure, smaller than the build size (the rule's second branch):
+    // whether dst came from a compacting copy is history the layer does not have here.
+    CountUnknownState(ctx);
+    return false;
+  }
+  return ReportDestinationTooSmall(ctx, cmd, i, (*dst)->size, sizes->acceleration_structure_size);
+}
+
+}  // namespace
+
+bool SignatureOfInfo(const BuildCommand& cmd, uint32_t i, BuildSignature* out) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  out->build_type =
+      cmd.is_host() ? VK_ACCELERATION_STRUCTURE_BUILD_TYPE_HOST_KHR : VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR;
+  out->info = &info;
+  if (cmd.is_indirect()) {
+    if (!cmd.max_primitive_counts || (info.geometryCount != 0 && !cmd.max_primitive_counts[i])) return false;
+    out->counts = cmd.max_primitive_counts[i];
+    out->count_stride = sizeof(uint32_t);
+    return true;
+  }
+  if (!cmd.ranges || (info.geometryCount != 0 && !cmd.ranges[i])) return false;
+  // primitiveCount is the first member of VkAccelerationStructureBuildRangeInfoKHR.
+  static_assert(offsetof(VkAccelerationStructureBuildRangeInfoKHR, primitiveCount) == 0);
+  out->counts = cmd.ranges[i] ? &cmd.ranges[i][0].primitiveCount : nullptr;
+  out->count_stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
+  return true;
+}
+
+bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature) {
+  const DeviceFeatures& f = state.features;
+  // vkGetAccelerationStructureBuildSizesKHR-accelerationStructure-08933, and rayTracingPipeline-03617 as the
+  // Khronos layer 1.3.239 reads it (rayQuery or rayTracingPipeline).
+  if (!f.acceleration_structure || !(f.ray_query || f.ray_tracing_pipeline) || !state.build_sizes.can_query()) {
+    return false;
+  }
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = *signature.info;
+  if (info.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR || info.pNext) return false;
+  if ((info.flags & ~kCoreBuildFlags) != 0 || (info.flags & kFastBoth) == kFastBoth) return false;
+  if (info.geometryCount != 0 && (info.pGeometries == nullptr) == (info.ppGeometries == nullptr)) return false;
+  const VkPhysicalDeviceAccelerationStructurePropertiesKHR& limits = state.properties.acceleration_structure;
+  if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+    return info.geometryCount == 1 &&
+           GeometryQueryable(state, signature.Geometry(0), VK_GEOMETRY_TYPE_INSTANCES_KHR) &&
+           signature.Count(0) <= limits.maxInstanceCount;
+  }
+  if (info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR || info.geometryCount > limits.maxGeometryCount) {
+    return false;
+  }
+  if (info.geometryCount == 0) return true;
+  const VkAccelerationStructureGeometryKHR* first = signature.Geometry(0);
+  if (!first || (first->geometryType != VK_GEOMETRY_TYPE_TRIANGLES_KHR &&
+                 first->geometryType != VK_GEOMETRY_TYPE_AABBS_KHR)) {
+    return false;
+  }
+  uint64_t primitives = 0;
+  for (uint32_t j = 0; j < info.geometryCount; ++j) {
+    if (!GeometryQueryable(state, signature.Geometry(j), first->geometryType)) return false;
+    primitives += signature.Count(j);
+  }
+  return primitives <= limits.maxPrimitiveCount;
+}
+
+std::optional<BuildSizes> SizesOfInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  BuildSignature signature;
+  BuildSizes sizes;
+  if (SignatureOfInfo(cmd, i, &signature)) {
+    if (ctx.state.build_sizes.Find(signature, &sizes)) return sizes;
+    if (SizeQueryIsValid(ctx.state, signature)) {
+      if (std::optional<BuildSizes> queried = ctx.state.build_sizes.Query(signature)) return queried;
+    }
+  }
+  CountUnknownState(ctx);
+  return std::nullopt;
+}
+
+bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                       const std::optional<BuildSizes>& sizes) {
+  return ValidateInstanceCounts(ctx, cmd, i) | ValidateDestinationSize(ctx, cmd, i, sizes);
+}
+
+}  // namespace asval

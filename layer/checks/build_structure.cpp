@@ -1,0 +1,179 @@
+#include "build_structure.h"
+
+#include "build_geometry_data.h"
+#include "build_report.h"
+#include "vk_enum_string.h"
+
+namespace asval {
+
+namespace {
+
+constexpr const char* kInfoVuid = "VUID-VkAccelerationStructureBuildGeometryInfoKHR-";
+
+std::string InfoVuid(const char* suffix) { return std::string(kInfoVuid) + suffix; }
+
+bool ValidateFlags(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkBuildAccelerationStructureFlagsKHR flags = cmd.infos[i].flags;
+  bool skip = false;
+  constexpr VkBuildAccelerationStructureFlagsKHR kFastBoth =
+      VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+  constexpr VkBuildAccelerationStructureFlagsKHR kMicromapBoth =
+      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_UPDATE_EXT |
+      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_DATA_UPDATE_EXT;
+  if ((flags & kFastBoth) == kFastBoth) {
+    skip |= ReportBuild(ctx, cmd, i, InfoVuid("flags-03796"),
+                        [&](std::string&) { return InfoLocation(cmd, i).Field("flags"); },
+                        "(0x{:x}) has both VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR and "
+                        "VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR set.",
+                        flags);
+  }
+  if ((flags & kMicromapBoth) == kMicromapBoth) {
+    skip |= ReportBuild(ctx, cmd, i, InfoVuid("flags-07334"),
+                        [&](std::string&) { return InfoLocation(cmd, i).Field("flags"); },
+                        "(0x{:x}) has both VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_UPDATE_BIT_EXT and "
+                        "VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_DATA_UPDATE_BIT_EXT set.",
+                        flags);
+  }
+  return skip;
+}
+
+// type-03793 (bottom level: geometryCount <= maxGeometryCount) and type-03790 (top level: exactly one).
+bool ValidateGeometryCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && info.geometryCount != 1) {
+    return ReportBuild(ctx, cmd, i, InfoVuid("type-03790"),
+                       [&](std::string&) { return InfoLocation(cmd, i).Field("geometryCount"); },
+                       "({}) is not 1, but pInfos[{}].type is VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR.",
+                       info.geometryCount, i);
+  }
+  if (info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
+  const uint64_t limit = ctx.state.properties.acceleration_structure.maxGeometryCount;
+  if (limit == 0) {
+    CountUnknownState(ctx);  // the driver's limit is unknown (no properties2)
+    return false;
+  }
+  if (info.geometryCount <= limit) return false;
+  return ReportBuild(ctx, cmd, i, InfoVuid("type-03793"),
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("geometryCount"); },
+                     "({}) is greater than VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxGeometryCount ({}) "
+                     "for a bottom-level build.",
+                     info.geometryCount, limit);
+}
+
+bool ValidateGeometryArrays(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (info.geometryCount == 0 || (info.pGeometries == nullptr) != (info.ppGeometries == nullptr)) return false;
+  return ReportBuild(ctx, cmd, i, InfoVuid("pGeometries-03788"),
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("pGeometries"); },
+                     "and ppGeometries are {}, but geometryCount is {}: exactly one of them must point to the "
+                     "geometries.",
+                     info.pGeometries ? "both non-NULL" : "both NULL", info.geometryCount);
+}
+
+// Totals of the primitives of a bottom-level build, by geometry type (type-03794 / 03795).
+struct PrimitiveTotals {
+  uint64_t triangles = 0;
+  uint64_t aabbs = 0;
+};
+
+bool ValidatePrimitiveTotals(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                             const PrimitiveTotals& totals) {
+  const uint64_t limit = ctx.state.properties.acceleration_structure.maxPrimitiveCount;
+  if (limit == 0) {
+    CountUnknownState(ctx);
+    return false;
+  }
+  bool skip = false;
+  if (totals.aabbs > limit) {
+    skip |= ReportBuild(ctx, cmd, i, InfoVuid("type-03794"), [&](std::string&) { return InfoLocation(cmd, i); },
+                        "is a bottom-level build of {} AABBs in all geometries (the sum of "
+                        "ppBuildRangeInfos[{}][j].primitiveCount), more than "
+                        "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
+                        totals.aabbs, i, limit);
+  }
+  if (totals.triangles > limit) {
+    skip |= ReportBuild(ctx, cmd, i, InfoVuid("type-03795"), [&](std::string&) { return InfoLocation(cmd, i); },
+                        "is a bottom-level build of {} triangles in all geometries (the sum of "
+                        "ppBuildRangeInfos[{}][j].primitiveCount), more than "
+                        "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
+                        totals.triangles, i, limit);
+  }
+  return skip;
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportGeometryType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                     uint32_t j, const char* suffix, const char* why) {
+  const VkGeometryTypeKHR type = GeometryAt(cmd.infos[i], j)->geometryType;
+  return ReportBuild(ctx, cmd, i, InfoVuid(suffix),
+                     [&](std::string&) { return GeometryLocation(cmd, i, j).Field("geometryType"); }, "({}) {}",
+                     string_VkGeometryTypeKHR(type), why);
+}
+
+// The geometries of one info: the type rules (type-03789, 03791, 03792), each geometry's data rules, and
+// the primitive totals of a bottom-level build.
+bool ValidateGeometries(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (!GeometriesWalkable(ctx, info)) return false;
+  const bool top = info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  const bool bottom = info.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  // Host-side primitive counts exist for direct and host builds; indirect counts live on the device.
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = cmd.ranges ? cmd.ranges[i] : nullptr;
+  bool skip = false;
+  bool type_reported = false;
+  PrimitiveTotals totals;
+  const VkAccelerationStructureGeometryKHR* first = nullptr;
+  for (uint32_t j = 0; j < info.geometryCount; ++j) {
+    const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
+    if (!geometry) continue;
+    if (!first) first = geometry;
+    const VkGeometryTypeKHR type = geometry->geometryType;
+    if (!type_reported && top && type != VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03789",
+                                 "is not VK_GEOMETRY_TYPE_INSTANCES_KHR, but the build is top-level.");
+      type_reported = true;
+    } else if (!type_reported && bottom && type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03791",
+                                 "is not allowed in a bottom-level build.");
+      type_reported = true;
+    } else if (!type_reported && bottom && type != first->geometryType) {
+      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03792",
+                                 "differs from the geometryType of the info's first geometry: all geometries of a "
+                                 "bottom-level build must have the same type.");
+      type_reported = true;
+    }
+    skip |= ValidateGeometryData(ctx, cmd, i, j, *geometry);
+    if (bottom && ranges) {
+      if (type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) totals.triangles += ranges[j].primitiveCount;
+      if (type == VK_GEOMETRY_TYPE_AABBS_KHR) totals.aabbs += ranges[j].primitiveCount;
+    }
+  }
+  if (bottom && ranges) skip |= ValidatePrimitiveTotals(ctx, cmd, i, totals);
+  return skip;
+}
+
+bool ValidateInfoStructure(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  bool skip = false;
+  if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) {
+    skip |= ReportBuild(ctx, cmd, i, InfoVuid("type-03654"),
+                        [&](std::string&) { return InfoLocation(cmd, i).Field("type"); },
+                        "is VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR: a build must say whether it is top- or "
+                        "bottom-level.");
+  }
+  skip |= ValidateFlags(ctx, cmd, i);
+  skip |= ValidateGeometryArrays(ctx, cmd, i);
+  skip |= ValidateGeometryCount(ctx, cmd, i);
+  skip |= ValidateGeometries(ctx, cmd, i);
+  return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildStructure(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.infos) return false;
+  bool skip = false;
+  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoStructure(ctx, cmd, i);
+  return skip;
+}
+
+}  // namespace asval

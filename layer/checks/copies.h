@@ -1,0 +1,30 @@
+#pragma once
+// The copies family: rules of the copy, serialization and property-query commands that the arguments and the
+// shadow state decide when the command is recorded (or, for host commands, called). Each returns true when a
+// callback asked that the call not be passed down.
+//   VkCopyAccelerationStructureInfoKHR: mode-03410, buffer-03718, buffer-03719, dst-07791
+//   VkCopyAccelerationStructureToMemoryInfoKHR: mode-03412; vkCmdCopyAccelerationStructureToMemoryKHR-pInfo-03740
+//   VkCopyMemoryToAccelerationStructureInfoKHR: mode-03413; vkCmdCopyMemoryToAccelerationStructureKHR-pInfo-03743
+//   vkCmdWriteAccelerationStructuresPropertiesKHR: queryType-06742, queryPool-02493, query-04880, buffer-03736
+//   vkWriteAccelerationStructuresPropertiesKHR: queryType-06742
+// (dst-03561 needs the source's serialization size for its current contents: checked at submission, see
+// update_rules.h.)
+#include <vulkan/vulkan.h>
+
+#include "check_context.h"
+
+namespace asval {
+
+// function: "vkCmdCopyAccelerationStructureKHR" or "vkCopyAccelerationStructureKHR"; cb: null for host calls.
+bool ValidateCopyInfo(const CheckContext& ctx, const char* function, VkCommandBuffer cb,
+                      const VkCopyAccelerationStructureInfoKHR& info);
+bool ValidateCopyToMemoryInfo(const CheckContext& ctx, const char* function, VkCommandBuffer cb,
+                              const VkCopyAccelerationStructureToMemoryInfoKHR& info);
+bool ValidateCopyMemoryToInfo(const CheckContext& ctx, const char* function, VkCommandBuffer cb,
+                              const VkCopyMemoryToAccelerationStructureInfoKHR& info);
+// pool is VK_NULL_HANDLE for the host command.
+bool ValidateWriteProperties(const CheckContext& ctx, const char* function, VkCommandBuffer cb, uint32_t count,
+                             const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
+                             uint32_t first_query);
+
+}  // namespace asval

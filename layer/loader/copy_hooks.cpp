@@ -1,0 +1,148 @@
+// Copies, serialization and property queries of acceleration structures: the copies family's record-time
+// rules, then (after a successful downcall) the operation for the build history: logged into the command
+// buffer (device commands, applied at submission) or checked now and applied on completion (host commands).
+#include "copies.h"
+#include "history_record.h"
+#include "history_submit.h"
+#include "layer_data.h"
+#include "vk_intercepts.h"
+
+namespace asval::hooks {
+
+namespace {
+
+CheckContext MakeCheckContext(const DeviceData& data) {
+  return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
+}
+
+// A host copy: record-time rules, history rules, the downcall, and its operations applied (or deferred).
+template <typename MakeOps, typename Validate, typename Downcall>
+VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR deferred, MakeOps&& make_ops,
+                  Validate&& validate, Downcall&& downcall) {
+  const CheckContext ctx = MakeCheckContext(data);
+  bool skip = ctx.Enabled(kCheckCopies) && validate(ctx);
+  OpBatch batch;
+  if (HistoryTracked(ctx.enabled_checks)) {
+    batch = make_ops();
+    skip |= CheckHostOps(data.state, *data.reporter, ctx.enabled_checks, batch, function);
+  }
+  // Skipped by the app's callback: the copy did not happen (VK_ERROR_VALIDATION_FAILED_EXT, as the Khronos
+  // layer returns).
+  if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
+  const VkResult result = downcall();
+  FinishHostOps(data.state, ctx.enabled_checks, std::move(batch), deferred, result);
+  return result;
+}
+
+}  // namespace
+
+VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureKHR(VkCommandBuffer commandBuffer,
+                                                           const VkCopyAccelerationStructureInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const CheckContext ctx = MakeCheckContext(*data);
+  if (pInfo && ctx.Enabled(kCheckCopies) &&
+      ValidateCopyInfo(ctx, "vkCmdCopyAccelerationStructureKHR", commandBuffer, *pInfo)) {
+    return;
+  }
+  data->dispatch.CmdCopyAccelerationStructureKHR(commandBuffer, pInfo);
+  if (pInfo) RecordDeviceCopy(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
+    VkCommandBuffer commandBuffer, const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const CheckContext ctx = MakeCheckContext(*data);
+  if (pInfo && ctx.Enabled(kCheckCopies) &&
+      ValidateCopyToMemoryInfo(ctx, "vkCmdCopyAccelerationStructureToMemoryKHR", commandBuffer, *pInfo)) {
+    return;
+  }
+  data->dispatch.CmdCopyAccelerationStructureToMemoryKHR(commandBuffer, pInfo);
+  if (pInfo) RecordDeviceCopyToMemory(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
+    VkCommandBuffer commandBuffer, const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const CheckContext ctx = MakeCheckContext(*data);
+  if (pInfo && ctx.Enabled(kCheckCopies) &&
+      ValidateCopyMemoryToInfo(ctx, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, *pInfo)) {
+    return;
+  }
+  data->dispatch.CmdCopyMemoryToAccelerationStructureKHR(commandBuffer, pInfo);
+  if (pInfo) RecordDeviceCopyMemoryTo(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(
+    VkCommandBuffer commandBuffer, uint32_t accelerationStructureCount,
+    const VkAccelerationStructureKHR* pAccelerationStructures, VkQueryType queryType, VkQueryPool queryPool,
+    uint32_t firstQuery) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const CheckContext ctx = MakeCheckContext(*data);
+  if (ctx.Enabled(kCheckCopies) &&
+      ValidateWriteProperties(ctx, "vkCmdWriteAccelerationStructuresPropertiesKHR", commandBuffer,
+                              accelerationStructureCount, pAccelerationStructures, queryType, queryPool, firstQuery)) {
+    return;
+  }
+  data->dispatch.CmdWriteAccelerationStructuresPropertiesKHR(commandBuffer, accelerationStructureCount,
+                                                             pAccelerationStructures, queryType, queryPool, firstQuery);
+  RecordDeviceWriteProperties(data->state, ctx.enabled_checks, commandBuffer, accelerationStructureCount,
+                              pAccelerationStructures, queryType, queryPool, firstQuery);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkDeferredOperationKHR deferredOperation,
+                                                            const VkCopyAccelerationStructureInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(device);
+  const char* function = "vkCopyAccelerationStructureKHR";
+  if (!pInfo) return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo);
+  return HostCopy(
+      *data, function, deferredOperation, [&] { return HostCopyOps(*pInfo); },
+      [&](const CheckContext& ctx) { return ValidateCopyInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [&] { return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
+    VkDevice device, VkDeferredOperationKHR deferredOperation, const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(device);
+  const char* function = "vkCopyAccelerationStructureToMemoryKHR";
+  if (!pInfo) return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo);
+  return HostCopy(
+      *data, function, deferredOperation, [&] { return HostCopyToMemoryOps(*pInfo); },
+      [&](const CheckContext& ctx) { return ValidateCopyToMemoryInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [&] { return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyMemoryToAccelerationStructureKHR(
+    VkDevice device, VkDeferredOperationKHR deferredOperation, const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
+  DeviceData* data = GetDeviceData(device);
+  const char* function = "vkCopyMemoryToAccelerationStructureKHR";
+  if (!pInfo) return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo);
+  return HostCopy(
+      *data, function, deferredOperation, [&] { return HostCopyMemoryToOps(*pInfo); },
+      [&](const CheckContext& ctx) { return ValidateCopyMemoryToInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [&] { return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
+    VkDevice device, uint32_t accelerationStructureCount, const VkAccelerationStructureKHR* pAccelerationStructures,
+    VkQueryType queryType, size_t dataSize, void* pData, size_t stride) {
+  DeviceData* data = GetDeviceData(device);
+  const char* function = "vkWriteAccelerationStructuresPropertiesKHR";
+  const CheckContext ctx = MakeCheckContext(*data);
+  bool skip = ctx.Enabled(kCheckCopies) &&
+              ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount,
+                                      pAccelerationStructures, queryType, VK_NULL_HANDLE, 0);
+  if (HistoryTracked(ctx.enabled_checks)) {
+    const OpBatch batch = HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType);
+    skip |= CheckHostOps(data->state, *data->reporter, ctx.enabled_checks, batch, function);
+  }
+  if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
+  const VkResult result = data->dispatch.WriteAccelerationStructuresPropertiesKHR(
+      device, accelerationStructureCount, pAccelerationStructures, queryType, dataSize, pData, stride);
+  if (result == VK_SUCCESS && queryType == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR &&
+      HistoryTracked(ctx.enabled_checks)) {
+    RecordHostSerializationSizes(data->state, accelerationStructureCount, pAccelerationStructures, pData, stride);
+  }
+  return result;
+}
+
+}  // namespace asval::hooks

@@ -1,0 +1,109 @@
+#pragma once
+// Per-device cache of what vkGetAccelerationStructureBuildSizesKHR answers for a build.
+//
+// The size rules (destination size, scratch ranges) and the aliasing rules (the bytes a build really touches)
+// need the sizes the driver reports "for an identical VkAccelerationStructureBuildGeometryInfoKHR and
+// primitive count". Asking the driver on every recorded build would cost more than the build's recording
+// (VVL issue #9428). A steady-state frame records the same builds with the same counts, so the answer is
+// cached by the build's signature: everything the sizes depend on (build type, structure type, flags, each
+// geometry's type, flags, formats, strides, maxVertex, index type, transform presence, instance layout and
+// primitive count), and nothing they do not (addresses, handles, mode: the driver ignores those).
+//
+// A hit hashes the signature, takes one shard's shared lock and compares the stored signature word by word
+// (so a hash collision can never return another build's sizes): no allocation, no driver call. A miss asks
+// the driver through the next layer's dispatch and stores the answer.
+//
+// Thread safety: Find/Query may run concurrently on any threads; Init runs once at device creation, before
+// another thread can see the device.
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <shared_mutex>
+#include <unordered_map>
+#include <vector>
+
+namespace asval {
+
+struct BuildSizes {
+  VkDeviceSize acceleration_structure_size = 0;
+  VkDeviceSize build_scratch_size = 0;
+  VkDeviceSize update_scratch_size = 0;
+};
+
+// One build as the size query sees it. The counts are read through a byte stride so that both
+// ppBuildRangeInfos[i] (primitiveCount is the first member of VkAccelerationStructureBuildRangeInfoKHR) and
+// ppMaxPrimitiveCounts[i] serve without a copy.
+struct BuildSignature {
+  VkAccelerationStructureBuildTypeKHR build_type = VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR;
+  const VkAccelerationStructureBuildGeometryInfoKHR* info = nullptr;
+  const uint32_t* counts = nullptr;  // count of geometry j at (const char*)counts + j * count_stride
+  std::size_t count_stride = sizeof(uint32_t);
+
+  uint32_t Count(uint32_t j) const {
+    return *reinterpret_cast<const uint32_t*>(reinterpret_cast<const char*>(counts) + j * count_stride);
+  }
+  // Geometry j, whichever of pGeometries / ppGeometries the info uses (null if neither).
+  const VkAccelerationStructureGeometryKHR* Geometry(uint32_t j) const;
+  // False when an extension structure (a pNext chain, a geometry type the layer does not know) could change the
+  // sizes in a way the signature does not capture: such builds are queried every time, never cached.
+  bool Cacheable() const;
+};
+
+class BuildSizeCache {
+ public:
+  using QueryFn = PFN_vkGetAccelerationStructureBuildSizesKHR;
+
+  BuildSizeCache() = default;
+  BuildSizeCache(const BuildSizeCache&) = delete;
+  BuildSizeCache& operator=(const BuildSizeCache&) = delete;
+
+  // The device and the next layer's vkGetAccelerationStructureBuildSizesKHR (null: the cache never queries).
+  void Init(VkDevice device, QueryFn query) {
+    device_ = device;
+    query_ = query;
+  }
+  bool can_query() const { return query_ != nullptr; }
+
+  // The cached sizes of this build, if it was queried before.
+  bool Find(const BuildSignature& signature, BuildSizes* out) const;
+
+  // Asks the driver and caches the answer (unless !signature.Cacheable()). The caller must have made sure
+  // that the query is valid for this info (the layer's own calls must be valid): features enabled, a
+  // structurally valid info, counts within the device's limits. The driver is told the handles, mode and
+  // addresses are absent (they are ignored by the query anyway), so stale handles never reach it.
+  std::optional<BuildSizes> Query(const BuildSignature& signature) const;
+
+  // Driver queries made so far (each lookup that missed and was answered). Hits are lookups minus these.
+  uint64_t queries() const { return queries_.load(std::memory_order_relaxed); }
+  std::size_t size() const;
+  void Clear();
+
+  // A shard holds at most this many signatures; a full shard is emptied (apps whose counts change every
+  // frame would otherwise grow the cache without bound).
+  static constexpr std::size_t kMaxEntriesPerShard = 1024;
+
+ private:
+  struct Entry {
+    std::vector<uint64_t> words;  // the full signature, compared on every hit
+    BuildSizes sizes;
+  };
+  struct alignas(64) Shard {
+    mutable std::shared_mutex mutex;
+    std::unordered_map<uint64_t, Entry> map;  // signature hash -> entry
+  };
+  static constexpr std::size_t kShardCount = 16;
+
+  Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
+
+  VkDevice device_ = VK_NULL_HANDLE;
+  QueryFn query_ = nullptr;
+  mutable std::array<Shard, kShardCount> shards_;
+  mutable std::atomic<uint64_t> queries_{0};
+};
+
+}  // namespace asval

@@ -1,0 +1,138 @@
+#include "command_buffer_ops.h"
+
+#include <cinttypes>
+#include <cstdio>
+
+namespace asval {
+
+const char* OpCommandName(OpCommand command) {
+  switch (command) {
+    case OpCommand::kCmdBuild: return "vkCmdBuildAccelerationStructuresKHR";
+    case OpCommand::kCmdBuildIndirect: return "vkCmdBuildAccelerationStructuresIndirectKHR";
+    case OpCommand::kHostBuild: return "vkBuildAccelerationStructuresKHR";
+    case OpCommand::kCmdCopy: return "vkCmdCopyAccelerationStructureKHR";
+    case OpCommand::kHostCopy: return "vkCopyAccelerationStructureKHR";
+    case OpCommand::kCmdCopyToMemory: return "vkCmdCopyAccelerationStructureToMemoryKHR";
+    case OpCommand::kHostCopyToMemory: return "vkCopyAccelerationStructureToMemoryKHR";
+    case OpCommand::kCmdCopyMemoryTo: return "vkCmdCopyMemoryToAccelerationStructureKHR";
+    case OpCommand::kHostCopyMemoryTo: return "vkCopyMemoryToAccelerationStructureKHR";
+    case OpCommand::kCmdWriteProperties: return "vkCmdWriteAccelerationStructuresPropertiesKHR";
+    case OpCommand::kHostWriteProperties: return "vkWriteAccelerationStructuresPropertiesKHR";
+    case OpCommand::kCount: break;
+  }
+  return "?";
+}
+
+const char* OpCommandArrayName(OpCommand command) {
+  switch (command) {
+    case OpCommand::kCmdBuild:
+    case OpCommand::kCmdBuildIndirect:
+    case OpCommand::kHostBuild: return "pInfos";
+    case OpCommand::kCmdWriteProperties:
+    case OpCommand::kHostWriteProperties: return "pAccelerationStructures";
+    default: return "pInfo";
+  }
+}
+
+namespace {
+
+std::string Ordinal(uint32_t n) {
+  const uint32_t tens = n % 100;
+  const char* suffix = (tens >= 11 && tens <= 13) ? "th" : n % 10 == 1 ? "st" : n % 10 == 2 ? "nd" : n % 10 == 3 ? "rd" : "th";
+  return std::to_string(n) + suffix;
+}
+
+std::string Handle(const void* handle) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "0x%" PRIxPTR, reinterpret_cast<uintptr_t>(handle));
+  return buf;
+}
+
+bool IsArray(OpCommand command) {
+  const std::string_view name = OpCommandArrayName(command);
+  return name != "pInfo";
+}
+
+}  // namespace
+
+std::string DescribeOrigin(const OpOrigin& origin) {
+  std::string text;
+  if (IsArray(origin.command)) {
+    text.append(OpCommandArrayName(origin.command)).append("[").append(std::to_string(origin.element)).append("] of ");
+  }
+  if (!origin.command_buffer) {
+    text.append("the ").append(OpCommandName(origin.command)).append(" call");
+    return text;
+  }
+  text.append("the ").append(Ordinal(origin.ordinal)).append(" ").append(OpCommandName(origin.command));
+  text.append(" in VkCommandBuffer ").append(Handle(origin.command_buffer));
+  if (origin.executed_by) {
+    text.append(" (a secondary executed by VkCommandBuffer ").append(Handle(origin.executed_by)).append(")");
+  }
+  return text;
+}
+
+void OpBatch::Clear() {
+  ops_.clear();
+  geometries_.clear();
+}
+
+GeometryRecord MakeGeometryRecord(const VkAccelerationStructureGeometryKHR& geometry) {
+  GeometryRecord record;
+  record.type = geometry.geometryType;
+  record.flags = geometry.flags;
+  if (geometry.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    const VkAccelerationStructureGeometryTrianglesDataKHR& t = geometry.geometry.triangles;
+    record.vertex_format = t.vertexFormat;
+    record.index_type = t.indexType;
+    record.max_vertex = t.maxVertex;
+    // The union's device and host members share storage: non-null either way reads as a non-zero address.
+    record.has_transform = t.transformData.deviceAddress != 0;
+  }
+  return record;
+}
+
+void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
+                           const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                           const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+  for (uint32_t i = 0; i < info_count; ++i) {
+    const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    AsOp op;
+    op.kind = OpKind::kBuild;
+    op.origin = origin;
+    op.origin.element = i;
+    op.src = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
+                                                                           : VK_NULL_HANDLE;
+    op.dst = info.dstAccelerationStructure;
+    op.mode = info.mode;
+    op.flags = info.flags;
+    op.type = info.type;
+    op.geometry_count = info.geometryCount;
+    op.first_geometry = static_cast<uint32_t>(geometries_.size());
+    const bool has_geometries = info.pGeometries || info.ppGeometries;
+    for (uint32_t j = 0; has_geometries && j < info.geometryCount; ++j) {
+      const VkAccelerationStructureGeometryKHR& g = info.pGeometries ? info.pGeometries[j] : *info.ppGeometries[j];
+      GeometryRecord record = MakeGeometryRecord(g);
+      if (ranges && ranges[i]) {
+        record.primitive_count = ranges[i][j].primitiveCount;
+        record.primitive_count_known = true;
+      }
+      geometries_.push_back(record);
+    }
+    if (!has_geometries) op.geometry_count = 0;  // nothing to compare (invalid, and another rule's business)
+    ops_.push_back(op);
+  }
+}
+
+void OpBatch::AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary) {
+  const uint32_t base = static_cast<uint32_t>(geometries_.size());
+  geometries_.insert(geometries_.end(), secondary.geometries_.begin(), secondary.geometries_.end());
+  for (AsOp op : secondary.ops_) {
+    op.first_geometry += base;
+    // A secondary executed inside another secondary keeps the outermost primary that ran it.
+    op.origin.executed_by = primary;
+    ops_.push_back(op);
+  }
+}
+
+}  // namespace asval

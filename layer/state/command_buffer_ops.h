@@ -1,0 +1,143 @@
+#pragma once
+// The acceleration-structure operations a command buffer (or one host call) performs, as a compact deep copy
+// of what the history rules need: the build parameters an update must repeat, the source and destination of
+// copies, where serialized bytes go, which structures a property query reads. Recorded when the command is
+// recorded; applied to the structures' histories when the command buffer is submitted (history.h).
+//
+// A batch owns two flat arrays (operations, and the geometries of every build in it), so recording a build
+// appends to vectors that keep their capacity across resets: a steady-state frame allocates nothing.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "memory_range.h"
+
+namespace asval {
+
+// The command an operation came from (for messages and ordinals).
+enum class OpCommand : uint8_t {
+  kCmdBuild,
+  kCmdBuildIndirect,
+  kHostBuild,
+  kCmdCopy,
+  kHostCopy,
+  kCmdCopyToMemory,
+  kHostCopyToMemory,
+  kCmdCopyMemoryTo,
+  kHostCopyMemoryTo,
+  kCmdWriteProperties,
+  kHostWriteProperties,
+  kCount
+};
+constexpr std::size_t kOpCommandCount = static_cast<std::size_t>(OpCommand::kCount);
+
+// "vkCmdBuildAccelerationStructuresKHR", ...
+const char* OpCommandName(OpCommand command);
+// The array parameter an operation is an element of: "pInfos", "pAccelerationStructures", or "pInfo".
+const char* OpCommandArrayName(OpCommand command);
+
+// Where an operation was recorded.
+struct OpOrigin {
+  OpCommand command = OpCommand::kCmdBuild;
+  uint32_t ordinal = 0;     // 1-based: the n-th call of `command` in command_buffer (0 for host calls)
+  uint32_t element = 0;     // pInfos[element] / pAccelerationStructures[element]
+  VkCommandBuffer command_buffer = VK_NULL_HANDLE;  // where recorded; null for host calls
+  VkCommandBuffer executed_by = VK_NULL_HANDLE;     // the primary that ran it, when recorded in a secondary
+};
+
+// "pInfos[0] of the 3rd vkCmdBuildAccelerationStructuresKHR in VkCommandBuffer 0x..." (allocates: reports only).
+std::string DescribeOrigin(const OpOrigin& origin);
+
+// One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769).
+struct GeometryRecord {
+  VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  VkGeometryFlagsKHR flags = 0;
+  VkFormat vertex_format = VK_FORMAT_UNDEFINED;  // triangles only
+  VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;  // triangles only
+  uint32_t max_vertex = 0;                       // triangles only
+  uint32_t primitive_count = 0;
+  bool has_transform = false;                    // triangles: transformData non-null
+  bool primitive_count_known = false;            // false for indirect builds (the count is on the device)
+
+  friend bool operator==(const GeometryRecord& a, const GeometryRecord& b) {
+    return a.type == b.type && a.flags == b.flags && a.vertex_format == b.vertex_format &&
+           a.index_type == b.index_type && a.max_vertex == b.max_vertex && a.primitive_count == b.primitive_count &&
+           a.has_transform == b.has_transform && a.primitive_count_known == b.primitive_count_known;
+  }
+  friend bool operator!=(const GeometryRecord& a, const GeometryRecord& b) { return !(a == b); }
+};
+
+enum class OpKind : uint8_t {
+  kBuild,            // a build or update (mode says which) of dst
+  kCopy,             // clone or compact src into dst
+  kSerialize,        // src into memory
+  kDeserialize,      // memory into dst
+  kWriteProperties,  // a property query of dst
+};
+
+// Where serialized bytes live: device memory (resolved through the address map when recorded) or host memory.
+struct SerializedLocation {
+  VkDeviceAddress device_address = 0;
+  const void* host_address = nullptr;
+  // The VkDeviceMemory bytes behind device_address, as far as the buffer containing it reaches; memory is
+  // VK_NULL_HANDLE when the address is in no buffer the layer knows (or the memory is not known).
+  MemorySpan span;
+  // Bytes from the address to the end of the largest buffer containing it; 0 when unknown.
+  VkDeviceSize capacity = 0;
+};
+
+struct AsOp {
+  OpKind kind = OpKind::kBuild;
+  OpOrigin origin;
+  VkAccelerationStructureKHR src = VK_NULL_HANDLE;  // build (updates), copy, serialize
+  VkAccelerationStructureKHR dst = VK_NULL_HANDLE;  // build, copy, deserialize, write properties
+
+  // kBuild
+  VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  VkBuildAccelerationStructureFlagsKHR flags = 0;
+  VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  uint32_t geometry_count = 0;
+  uint32_t first_geometry = 0;  // index into the batch's geometries
+
+  // kCopy, kSerialize, kDeserialize
+  VkCopyAccelerationStructureModeKHR copy_mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+  SerializedLocation memory;  // kSerialize: destination; kDeserialize: source
+
+  // kWriteProperties
+  VkQueryType query_type = VK_QUERY_TYPE_OCCLUSION;
+  VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
+  uint32_t query = 0;                       // firstQuery + element
+
+  bool is_update() const { return kind == OpKind::kBuild && mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR; }
+};
+
+// A sequence of operations in execution order, with their geometries.
+class OpBatch {
+ public:
+  const std::vector<AsOp>& ops() const { return ops_; }
+  const std::vector<GeometryRecord>& geometries() const { return geometries_; }
+  const GeometryRecord* GeometriesOf(const AsOp& op) const { return geometries_.data() + op.first_geometry; }
+  bool empty() const { return ops_.empty(); }
+
+  // Clears and keeps the capacity.
+  void Clear();
+
+  // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
+  void AppendBuilds(const OpOrigin& origin, uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+  // Any other operation (no geometries).
+  void Append(const AsOp& op) { ops_.push_back(op); }
+  // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.
+  void AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary);
+
+ private:
+  std::vector<AsOp> ops_;
+  std::vector<GeometryRecord> geometries_;
+};
+
+// Reads one geometry of a build info into its record; primitive_count is set by the caller.
+GeometryRecord MakeGeometryRecord(const VkAccelerationStructureGeometryKHR& geometry);
+
+}  // namespace asval

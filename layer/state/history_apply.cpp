@@ -1,0 +1,222 @@
+#include "history_apply.h"
+
+#include <cstring>
+
+namespace asval {
+
+namespace {
+
+// Builds with identical parameters share one snapshot, so that a structure rebuilt or updated every frame
+// costs no allocation (the snapshot's origin then names the first of the identical builds).
+bool SameParameters(const BuildSnapshot& snapshot, const OpBatch& batch, const AsOp& op) {
+  if (snapshot.flags != op.flags || snapshot.type != op.type || snapshot.geometries.size() != op.geometry_count) {
+    return false;
+  }
+  const GeometryRecord* geometries = batch.GeometriesOf(op);
+  for (uint32_t j = 0; j < op.geometry_count; ++j) {
+    if (snapshot.geometries[j] != geometries[j]) return false;
+  }
+  return true;
+}
+
+std::shared_ptr<const BuildSnapshot> MakeSnapshot(const OpBatch& batch, const AsOp& op) {
+  auto snapshot = std::make_shared<BuildSnapshot>();
+  snapshot->flags = op.flags;
+  snapshot->type = op.type;
+  const GeometryRecord* geometries = batch.GeometriesOf(op);
+  snapshot->geometries.assign(geometries, geometries + op.geometry_count);
+  snapshot->origin = op.origin;
+  return snapshot;
+}
+
+// For an update: the source's snapshot when the update repeats it (primitive counts an indirect update
+// does not know are taken as repeated), else the update's own parameters.
+std::shared_ptr<const BuildSnapshot> UpdateSnapshot(const AsHistory& src, const OpBatch& batch, const AsOp& op) {
+  if (src.kind == HistoryKind::kBuilt && src.build) {
+    const BuildSnapshot& s = *src.build;
+    bool same = s.flags == op.flags && s.type == op.type && s.geometries.size() == op.geometry_count;
+    const GeometryRecord* geometries = batch.GeometriesOf(op);
+    for (uint32_t j = 0; same && j < op.geometry_count; ++j) {
+      GeometryRecord g = geometries[j];
+      if (!g.primitive_count_known) {
+        g.primitive_count = s.geometries[j].primitive_count;
+        g.primitive_count_known = s.geometries[j].primitive_count_known;
+      }
+      same = g == s.geometries[j];
+    }
+    if (same) return src.build;
+  }
+  return MakeSnapshot(batch, op);
+}
+
+// The written structure's new record, with its span, a fresh generation and no clobber.
+AsHistory Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
+  AsHistory h;
+  if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) h.span = *span;
+  h.generation = store.NextGeneration();
+  return h;
+}
+
+// A write of `span` by `op` leaves every other structure there with contents that are not what was built, and
+// any serialized bytes there modified.
+void ClobberOverlapping(HistoryStore& store, const MemorySpan& span, VkAccelerationStructureKHR writer,
+                        const AsOp& op, Transaction* txn) {
+  if (span.memory == VK_NULL_HANDLE) return;
+  store.InvalidateBlobsOverlapping(span, txn);
+  // Collected first: Set() may re-index while the span index is being walked otherwise.
+  VkAccelerationStructureKHR hits[16];
+  std::size_t count = 0;
+  bool more = true;
+  while (more) {
+    more = false;
+    count = 0;
+    store.ForEachOverlapping(span, writer, [&](VkAccelerationStructureKHR as) {
+      const AsHistory* h = store.Find(as);
+      if (!h || h->kind == HistoryKind::kNeverBuilt || h->clobbered) return;
+      if (count < 16) {
+        hits[count++] = as;
+      } else {
+        more = true;
+      }
+    });
+    for (std::size_t i = 0; i < count; ++i) {
+      AsHistory h = *store.Find(hits[i]);
+      h.clobbered = Clobber{op.origin, writer};
+      store.Set(hits[i], std::move(h), txn);
+    }
+  }
+}
+
+void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h, const AsOp& op,
+                Transaction* txn) {
+  const MemorySpan span = h.span;
+  if (h.kind == HistoryKind::kUnknown) store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+  store.Set(dst, std::move(h), txn);
+  ClobberOverlapping(store, span, dst, op, txn);
+}
+
+void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
+                Transaction* txn) {
+  AsHistory h = Fresh(state, store, op.dst);
+  h.kind = HistoryKind::kBuilt;
+  if (op.is_update()) {
+    h.build = UpdateSnapshot(store.Get(op.src), batch, op);
+  } else {
+    const AsHistory* old = store.Find(op.dst);
+    h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);
+  }
+  SetWritten(store, op.dst, std::move(h), op, txn);
+}
+
+void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
+  const AsHistory src = store.Get(op.src);
+  AsHistory h = Fresh(state, store, op.dst);
+  if (src.kind == HistoryKind::kBuilt) {
+    h.kind = HistoryKind::kBuilt;
+    h.build = src.build;
+  } else {
+    // Copying a structure never built is its own error (src-04963); what lands in dst is unknown either way.
+    h.kind = HistoryKind::kUnknown;
+    h.unknown_reason = UnknownReason::kCopiedFromUnknown;
+  }
+  SetWritten(store, op.dst, std::move(h), op, txn);
+}
+
+void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn) {
+  const AsHistory src = store.Get(op.src);
+  SerializedBlob blob;
+  blob.history.kind = src.kind;
+  blob.history.unknown_reason = src.unknown_reason;
+  blob.history.build = src.build;
+  if (op.memory.host_address) {
+    store.InvalidateHostBlob(op.memory.host_address, txn);
+    blob.host_address = op.memory.host_address;
+    blob.host_size = SerializedHostSize(op.memory.host_address);
+    blob.host_hash = HashBytes(op.memory.host_address, blob.host_size);
+    store.AddBlob(std::move(blob), txn);
+    return;
+  }
+  if (op.memory.span.memory == VK_NULL_HANDLE) return;  // bytes in memory the layer does not know
+  const bool size_known = src.serialization_size_generation != 0 && src.serialization_size_generation == src.generation;
+  blob.span = op.memory.span;
+  if (size_known && src.serialization_size < blob.span.end - blob.span.begin) {
+    blob.span.end = blob.span.begin + src.serialization_size;
+  }
+  // The bytes written: exactly known only with the serialization size. Without it, older serialized bytes
+  // up to the buffer's end are taken as overwritten (they then restore nothing: safe), but no structure is
+  // reported as clobbered on a guess.
+  if (size_known) {
+    ClobberOverlapping(store, blob.span, VK_NULL_HANDLE, op, txn);
+  } else {
+    store.InvalidateBlobsOverlapping(blob.span, txn);
+  }
+  store.AddBlob(std::move(blob), txn);
+}
+
+void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
+  AsHistory h = Fresh(state, store, op.dst);
+  const SerializedBlob* blob = nullptr;
+  if (op.memory.host_address) {
+    const SerializedBlob* candidate = store.FindHostBlob(op.memory.host_address);
+    // Host bytes may have been rewritten by the app without the layer seeing it: compare them.
+    if (candidate && SerializedHostSize(op.memory.host_address) == candidate->host_size &&
+        HashBytes(op.memory.host_address, candidate->host_size) == candidate->host_hash) {
+      blob = candidate;
+    }
+  } else {
+    blob = store.FindDeviceBlob(op.memory.span);
+  }
+  if (blob && blob->history.kind == HistoryKind::kBuilt) {
+    h.kind = HistoryKind::kBuilt;
+    h.build = blob->history.build;
+  } else {
+    h.kind = HistoryKind::kUnknown;
+    h.unknown_reason = blob ? UnknownReason::kCopiedFromUnknown : UnknownReason::kDeserializedUnknownBytes;
+  }
+  SetWritten(store, op.dst, std::move(h), op, txn);
+}
+
+void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn) {
+  if (!op.query_pool) return;  // host writes hand their values over at once (RecordSerializationSize)
+  const AsHistory* h = store.Find(op.dst);
+  store.SetSlot(op.query_pool, op.query, QuerySlot{op.dst, h ? h->generation : 0, op.query_type}, txn);
+}
+
+}  // namespace
+
+std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as) {
+  std::optional<std::shared_ptr<const AccelerationStructureState>> record = state.acceleration_structures.find(as);
+  if (!record || !*record) return std::nullopt;
+  std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find((*record)->buffer);
+  if (!buffer || !*buffer || !(*buffer)->bound) return std::nullopt;
+  const MemoryBinding binding{(*buffer)->memory, (*buffer)->memory_offset, true};
+  return ResolveMemorySpan(binding, (*record)->offset, (*record)->size);
+}
+
+void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn) {
+  store.ops_applied.fetch_add(1, std::memory_order_relaxed);
+  switch (op.kind) {
+    case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn); break;
+    case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;
+    case OpKind::kSerialize: ApplySerialize(store, op, txn); break;
+    case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn); break;
+    case OpKind::kWriteProperties: ApplyWriteProperties(store, op, txn); break;
+  }
+}
+
+void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size) {
+  const AsHistory* current = store.Find(as);
+  if (!current || current->generation != generation || generation == 0) return;  // rebuilt since: stale
+  AsHistory h = *current;
+  h.serialization_size = size;
+  h.serialization_size_generation = generation;
+  store.Set(as, std::move(h), nullptr);
+}
+
+uint64_t SerializedHostSize(const void* data) {
+  uint64_t size = 0;
+  std::memcpy(&size, static_cast<const unsigned char*>(data) + 2 * VK_UUID_SIZE, sizeof(size));
+  return size;
+}
+
+}  // namespace asval

@@ -1,0 +1,27 @@
+#pragma once
+// How each operation changes the histories once it executes (the checks against the history *before* the
+// operation are in layer/checks/update_rules.cpp). Call with the store's lock held.
+#include <vulkan/vulkan.h>
+
+#include <optional>
+
+#include "device_state.h"
+
+namespace asval {
+
+// The VkDeviceMemory bytes a structure occupies (its buffer's binding, offset and size); nullopt when the
+// structure, its buffer or the binding is unknown.
+std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as);
+
+// Applies one operation of `batch` to the histories in `state.history.store`. txn (may be null) collects the
+// changes so that a skipped or failed submission can be rolled back.
+void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn);
+
+// Serialization sizes read back on the host (vkWriteAccelerationStructuresPropertiesKHR, or a query result
+// fetched with vkGetQueryPoolResults) for the structure's current contents.
+void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size);
+
+// Where serialized bytes end: the header's total size (bytes 32..39, VK_UUID_SIZE * 2 in) of host data.
+uint64_t SerializedHostSize(const void* data);
+
+}  // namespace asval

@@ -1,0 +1,196 @@
+#pragma once
+// Helpers for the build-history and copies tests: command buffers recorded now and submitted later (in any
+// order, more than once), bottom- and top-level structures whose builds and updates take a "shape" (the
+// parameters an update must repeat), copies, serialization and property queries.
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fixture.h"
+
+namespace asval_test {
+
+// A Fixture whose enabled_checks names only `families` (null: every family), plus any other settings.
+// Negative tests narrow the families, so that a rule of another family about the same deliberately broken
+// input adds no finding of its own; valid twins keep every family on.
+class HistoryFixture {
+ public:
+  explicit HistoryFixture(const char* families = nullptr,
+                          const std::vector<std::pair<const char*, const char*>>& settings = {});
+  Monitor& monitor() { return fixture_->monitor(); }
+  vkkit::Instance& instance() { return fixture_->instance(); }
+  vkkit::Device& device() { return fixture_->device(); }
+  // Destroys the device and the instance now, e.g. for the summary vkDestroyDevice writes to a report file.
+  void Close() { fixture_.reset(); }
+
+ private:
+  ApiSettings settings_;
+  std::unique_ptr<Fixture> fixture_;
+};
+
+// Entry points the tests call that vkkit does not load.
+struct Procs {
+  explicit Procs(vkkit::Device& device);
+  PFN_vkCmdBuildAccelerationStructuresKHR CmdBuild = nullptr;
+  PFN_vkBuildAccelerationStructuresKHR HostBuild = nullptr;
+  PFN_vkCmdCopyAccelerationStructureKHR CmdCopy = nullptr;
+  PFN_vkCmdCopyAccelerationStructureToMemoryKHR CmdCopyToMemory = nullptr;
+  PFN_vkCmdCopyMemoryToAccelerationStructureKHR CmdCopyMemoryTo = nullptr;
+  PFN_vkCmdWriteAccelerationStructuresPropertiesKHR CmdWriteProperties = nullptr;
+  PFN_vkCopyAccelerationStructureKHR HostCopy = nullptr;
+  PFN_vkWriteAccelerationStructuresPropertiesKHR HostWriteProperties = nullptr;
+  PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
+  PFN_vkQueueSubmit2 QueueSubmit2 = nullptr;
+};
+
+// Command buffers from one pool, recorded whenever and submitted in any order; all freed at the end.
+class Commands {
+ public:
+  explicit Commands(vkkit::Device& device);
+  ~Commands();
+  VkCommandBuffer Begin();           // a new primary command buffer, begun
+  VkCommandBuffer BeginSecondary();  // a new secondary command buffer, begun (no render pass)
+  void End(VkCommandBuffer cb);
+  // AS-build and AS-copy writes before the next AS-build/copy reads and writes (and query writes).
+  void Barrier(VkCommandBuffer cb);
+  // Submits `cbs` as one batch and, when the layer let it through, waits for the queue. The layer's result.
+  VkResult Submit(const std::vector<VkCommandBuffer>& cbs);
+  VkResult Submit(VkCommandBuffer cb) { return Submit(std::vector<VkCommandBuffer>{cb}); }
+  VkCommandPool pool() const { return pool_; }
+
+ private:
+  vkkit::Device& device_;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  std::vector<VkCommandBuffer> buffers_;
+};
+
+// The parameters of a bottom-level build that an update must repeat.
+struct Shape {
+  uint32_t geometries = 1;
+  uint32_t triangles = 1;  // primitiveCount of each geometry
+  VkBuildAccelerationStructureFlagsKHR flags =
+      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  VkGeometryTypeKHR geometry_type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;  // or VK_GEOMETRY_TYPE_AABBS_KHR
+  VkGeometryFlagsKHR geometry_flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  VkFormat vertex_format = VK_FORMAT_R32G32B32_SFLOAT;
+  uint32_t max_vertex = 0;  // 0: the highest vertex the triangles use
+  VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
+  bool transform = false;
+};
+
+// Build inputs for any Shape (up to kMaxGeometries geometries of kMaxTriangles triangles): vertices, 32-bit
+// indices, a transform and AABBs, in one host-visible buffer.
+class Inputs {
+ public:
+  static constexpr uint32_t kMaxGeometries = 3;
+  static constexpr uint32_t kMaxTriangles = 2;
+  static constexpr uint32_t kVertexCount = 16;
+  explicit Inputs(vkkit::Device& device);
+  ~Inputs();
+  Inputs(const Inputs&) = delete;
+  Inputs& operator=(const Inputs&) = delete;
+  VkDeviceAddress vertices() const { return buffer_.address; }
+  VkDeviceAddress indices() const { return buffer_.address + 256; }
+  VkDeviceAddress transform() const { return buffer_.address + 512; }
+  VkDeviceAddress aabbs() const { return buffer_.address + 768; }
+
+ private:
+  vkkit::Device& device_;
+  vkkit::Buffer buffer_;
+};
+
+// What a vkCmdBuild/vkBuild call needs for one info of a Shape, kept alive while the call runs.
+struct BuildInfo {
+  std::vector<VkAccelerationStructureGeometryKHR> geometries;
+  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges;
+  VkAccelerationStructureBuildGeometryInfoKHR info{};
+  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = nullptr;
+};
+BuildInfo MakeBuildInfo(const Shape& shape, const Inputs& inputs);
+
+// A structure with storage and scratch big enough for any Shape. `shared` places it in another structure's
+// storage buffer (at the same offset: the two alias) instead of a buffer of its own.
+class Blas {
+ public:
+  Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared = nullptr);
+  ~Blas();
+  Blas(const Blas&) = delete;
+  Blas& operator=(const Blas&) = delete;
+
+  VkAccelerationStructureKHR handle() const { return handle_; }
+  VkDeviceAddress address() const { return address_; }
+  void SetInputs(const Inputs& inputs) { inputs_ = &inputs; }
+
+  void Build(VkCommandBuffer cb, const Shape& shape);
+  // An update of `src` (this structure itself when null) into this structure.
+  void Update(VkCommandBuffer cb, const Shape& shape, const Blas* src = nullptr);
+  // vkBuildAccelerationStructuresKHR (host): an update of this structure in place. Only for calls the layer
+  // skips (lavapipe has no host commands).
+  VkResult HostUpdate(const Shape& shape);
+  // Destroys the structure (not its storage) and creates a new one in the same place.
+  void Recreate();
+
+ private:
+  void Create();
+  void Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
+              VkAccelerationStructureKHR src);
+
+  vkkit::Device& device_;
+  Procs procs_;
+  const Inputs* inputs_;
+  vkkit::Buffer storage_;  // own storage (empty when shared)
+  VkBuffer storage_buffer_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  vkkit::Buffer scratch_;
+  VkAccelerationStructureKHR handle_ = VK_NULL_HANDLE;
+  VkDeviceAddress address_ = 0;
+};
+
+// A top-level structure over instances of bottom-level structures, read from an instance buffer that the
+// caller may replace every frame.
+class Tlas {
+ public:
+  explicit Tlas(vkkit::Device& device);
+  ~Tlas();
+  // A new instance buffer referencing `blases` (one instance each).
+  vkkit::Buffer MakeInstances(const std::vector<const Blas*>& blases);
+  void Record(VkCommandBuffer cb, const vkkit::Buffer& instances, uint32_t count,
+              VkBuildAccelerationStructureModeKHR mode);
+  VkAccelerationStructureKHR handle() const { return as_.handle; }
+
+ private:
+  vkkit::Device& device_;
+  Procs procs_;
+  vkkit::AccelerationStructure as_;
+  vkkit::Buffer scratch_;
+};
+
+// A query pool of `count` queries of `type`, reset by vkCmdResetQueryPool in Reset().
+class QueryPool {
+ public:
+  QueryPool(vkkit::Device& device, VkQueryType type, uint32_t count);
+  ~QueryPool();
+  VkQueryPool handle() const { return pool_; }
+  void Reset(VkCommandBuffer cb);
+  // Waits for and returns the 64-bit results.
+  std::vector<uint64_t> Results();
+
+ private:
+  vkkit::Device& device_;
+  VkQueryPool pool_ = VK_NULL_HANDLE;
+  uint32_t count_ = 0;
+};
+
+// Copy commands.
+void CmdCopy(vkkit::Device& device, VkCommandBuffer cb, VkAccelerationStructureKHR src, VkAccelerationStructureKHR dst,
+             VkCopyAccelerationStructureModeKHR mode);
+void CmdSerialize(vkkit::Device& device, VkCommandBuffer cb, VkAccelerationStructureKHR src, VkDeviceAddress dst);
+void CmdDeserialize(vkkit::Device& device, VkCommandBuffer cb, VkDeviceAddress src, VkAccelerationStructureKHR dst);
+void CmdWriteProperties(vkkit::Device& device, VkCommandBuffer cb, std::vector<VkAccelerationStructureKHR> structures,
+                        VkQueryType type, VkQueryPool pool, uint32_t first_query);
+// vkCmdCopyBuffer of `size` bytes (a write the layer does not track).
+void CmdCopyBuffer(VkCommandBuffer cb, const vkkit::Buffer& src, const vkkit::Buffer& dst, VkDeviceSize size);
+
+}  // namespace asval_test
