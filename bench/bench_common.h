@@ -12,7 +12,8 @@ namespace bench {
 const scenes::Scene& CachedScene(const std::string& name, uint32_t triangles);
 
 struct BuildRun {
-    double seconds = 0;          // AppendTriangles + BuildBvh, wall clock
+    double seconds = 0;          // AppendTriangles + SplitLargeTriangles + BuildBvh, wall clock
+    double cpuSeconds = 0;       // the same span in process CPU time (robust to other load on the machine)
     double prepareSeconds = 0;   // AppendTriangles alone (classification + conservative boxes)
     double sah = 0;
     size_t peakBytes = 0;        // heap peak above the scene itself

@@ -64,6 +64,8 @@ void BM_Build(benchmark::State& state, const char* sceneName, BuildMode mode) {
     state.counters["peak_B_per_prim"] = double(last.peakBytes) / s.triangles;
     state.counters["prepare_share"] = last.prepareSeconds / last.seconds;
     state.counters["depth"] = last.stats.maxDepth;
+    state.counters["cpu_Mprims_per_s"] = s.triangles / last.cpuSeconds * 1e-6;
+    state.counters["split_refs"] = last.stats.splitReferences;
 }
 
 void BM_EmbreeCommit(benchmark::State& state, const char* sceneName, int quality) {

@@ -25,8 +25,10 @@ def main(path, out):
     for r in rows:
         if r["builder"] == "embree_user_HIGH":
             high[r["scene"]] = float(r["sah"])
-    fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4.2), squeeze=False)
-    for ax, scene in zip(axes[0], scenes):
+    cols = 2 if len(scenes) > 1 else 1
+    rows_n = (len(scenes) + cols - 1) // cols
+    fig, axes = plt.subplots(rows_n, cols, figsize=(7 * cols, 5 * rows_n), squeeze=False)
+    for ax, scene in zip([a for row in axes for a in row], scenes):
         series = defaultdict(list)
         for r in rows:
             if r["scene"] != scene or r["threads"] != "1":
@@ -44,8 +46,9 @@ def main(path, out):
             else:
                 key = b
                 if b == "asval_sah":
-                    key = "asval SAH: " + ("split budget" if "split" in r["knobs"]
-                                           else "bins" if r["knobs"].endswith("leaf8") else "max leaf")
+                    k = r["knobs"]
+                    key = "asval SAH: " + ("split budget/factor" if ("split" in k or "factor" in k)
+                                           else "bins" if k.endswith("leaf8") else "max leaf")
                 series[key].append((ms, ratio, r["knobs"]))
         for key, pts in series.items():
             pts.sort()
@@ -60,6 +63,8 @@ def main(path, out):
                 ax.annotate("Embree HIGH (2T)", (float(r["seconds"]) * 1e3, 1.0), fontsize=7,
                             textcoords="offset points", xytext=(4, -10))
         ax.set_xscale("log")
+        if scene == "clustered":
+            ax.set_yscale("log")
         ax.set_title(scene)
         ax.set_xlabel("build time, 1 thread (ms)")
         ax.set_ylabel("SAH / Embree HIGH SAH")

@@ -43,12 +43,14 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
     "vkGetQueryPoolResults",
+    "vkMapMemory",
     "vkQueueSubmit",
     "vkQueueSubmit2",
     "vkQueueSubmit2KHR",
     "vkResetCommandBuffer",
     "vkResetCommandPool",
     "vkSetDebugUtilsObjectNameEXT",
+    "vkUnmapMemory",
     "vkWriteAccelerationStructuresPropertiesKHR",
 };
 
@@ -90,12 +92,14 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR
     true,  // vkGetQueryPoolResults
+    true,  // vkMapMemory
     true,  // vkQueueSubmit
     true,  // vkQueueSubmit2
     true,  // vkQueueSubmit2KHR
     true,  // vkResetCommandBuffer
     true,  // vkResetCommandPool
     true,  // vkSetDebugUtilsObjectNameEXT
+    true,  // vkUnmapMemory
     true,  // vkWriteAccelerationStructuresPropertiesKHR
 };
 

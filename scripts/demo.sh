@@ -42,7 +42,7 @@ done
 echo
 "$scene" --list-faults >"$out/faults.txt"
 python3 - "$out" <<'PY'
-import json, os, sys
+import json, os, re, sys
 out = sys.argv[1]
 rows, detected = [], 0
 for line in open(os.path.join(out, "faults.txt")):
@@ -53,19 +53,24 @@ for line in open(os.path.join(out, "faults.txt")):
         if os.path.exists(os.path.join(out, fault + ".jsonl")) else []
     errors = [f for f in findings if f.get("severity") == "error"]
     hit = [f for f in errors if f.get("vuid") == vuid]
-    if hit:
-        detected += 1
-        message = (hit[0].get("location", "") + " " + hit[0].get("message", "")).strip()
-    elif errors:
-        message = "other: %s %s" % (errors[0].get("vuid"), errors[0].get("message", ""))
+    shown = hit[0] if hit else (errors[0] if errors else None)
+    if shown:
+        # Abridged for the table (the full text is in the report): the submission path of submit-time
+        # findings is left out, and object handles are shortened.
+        location = shown.get("location", "")
+        location = "" if location.startswith("pSubmits") else location
+        message = (location + " " + shown.get("message", "")).strip().splitlines()[0]
+        message = re.sub(r"0x[0-9a-f]{9,}", "0x..", message)
+        if not hit:
+            message = "other: %s %s" % (shown.get("vuid"), message)
     else:
         message = "-"
-    message = message.splitlines()[0] if message else "-"
+    detected += 1 if hit else 0
     rows.append((fault, vuid.replace("VUID-", ""), "yes" if hit else "no", message))
 widths = [max(len(r[i]) for r in rows + [("fault", "expected VUID", "reported", "")]) for i in range(3)]
 head = ("fault", "expected VUID", "reported", "message")
 print("| " + " | ".join(h.ljust(w) for h, w in zip(head, widths + [0])) + " |")
-print("|" + "|".join("-" * (w + 2) for w in widths + [9]) + "|")
+print("|" + "|".join("-" * (w + 2) for w in widths + [7]) + "|")
 for r in rows:
     m = r[3] if len(r[3]) <= 140 else r[3][:137] + "..."
     print("| " + " | ".join(c.ljust(w) for c, w in zip(r[:3], widths)) + " | " + m + " |")

@@ -1,6 +1,7 @@
 #include "build_addresses.h"
 
 #include "buffer_lookup.h"
+#include "buffer_memo.h"
 #include "build_report.h"
 #include "build_sizes.h"
 #include "vertex_format_alignment.h"
@@ -152,7 +153,7 @@ int ReadsOfGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAcceler
   return skip;
 }
 
-bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
@@ -169,8 +170,9 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
     }
     InputRead reads[3];
     const int n = ReadsOfGeometry(*g, range, reads);
+    KnownBuffer holder;
     for (int k = 0; k < n; ++k) {
-      if (!FindBufferHolding(ctx.state, reads[k].address, reads[k].size, kInputUsage)) {
+      if (!memo.Holding(ctx.state, reads[k].address, reads[k].size, kInputUsage, &holder)) {
         skip |= ReportRead(ctx, cmd, i, j, reads[k]);
       }
     }
@@ -217,18 +219,10 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
   return skip;
 }
 
-bool ValidateScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                     const std::optional<BuildSizes>& sizes) {
-  if (!sizes) return false;  // counted by SizesOfInfo
-  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  const VkDeviceSize needed = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR
-                                  ? sizes->update_scratch_size
-                                  : sizes->build_scratch_size;
-  if (needed == 0) return false;  // no scratch is read or written
-  if (FindBufferHolding(ctx.state, info.scratchData.deviceAddress, needed, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
-    return false;
-  }
-  return ReportScratch(ctx, cmd, i, needed);
+bool ValidateScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
+  // No size (counted by SizesOfInfo), or a zero size: no scratch is read or written.
+  if (r.scratch_bytes == 0 || r.scratch_in_storage) return false;
+  return ReportScratch(ctx, cmd, i, r.scratch_bytes);
 }
 
 [[gnu::cold, gnu::noinline]] bool ReportIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
@@ -257,11 +251,12 @@ bool ValidateScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t 
   return skip;
 }
 
-bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, BufferMemo& memo) {
   if (!cmd.indirect_addresses || !cmd.indirect_strides) return false;
   const VkDeviceSize bytes = SaturatingMul(cmd.infos[i].geometryCount, cmd.indirect_strides[i]);
   if (bytes == 0) return false;  // no range is read
-  if (FindBufferHolding(ctx.state, cmd.indirect_addresses[i], bytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)) {
+  KnownBuffer holder;
+  if (memo.Holding(ctx.state, cmd.indirect_addresses[i], bytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, &holder)) {
     return false;
   }
   return ReportIndirectRanges(ctx, cmd, i, bytes);
@@ -269,17 +264,13 @@ bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, ui
 
 }  // namespace
 
-bool ValidateBuildAddresses(const CheckContext& ctx, const BuildCommand& cmd) {
-  if (!cmd.infos) return false;
-  bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) {
-    const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
-    skip |= ValidateInfoSizes(ctx, cmd, i, sizes);
-    if (cmd.is_host()) continue;  // host addresses: build_host.h
-    skip |= ValidateScratch(ctx, cmd, i, sizes);
-    skip |= ValidateGeometryInputs(ctx, cmd, i);
-    if (cmd.is_indirect()) skip |= ValidateIndirectRanges(ctx, cmd, i);
-  }
+bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                           BufferMemo& memo) {
+  bool skip = ValidateInfoSizes(ctx, cmd, i, r);
+  if (cmd.is_host()) return skip;  // host addresses: build_host.h
+  skip |= ValidateScratch(ctx, cmd, i, r);
+  skip |= ValidateGeometryInputs(ctx, cmd, i, memo);
+  if (cmd.is_indirect()) skip |= ValidateIndirectRanges(ctx, cmd, i, memo);
   return skip;
 }
 

@@ -12,12 +12,15 @@
 //       size is not 0; the direct command's rules are read the same way (a zero-size scratch reads nothing)
 //   pIndirectDeviceAddresses-03646 / 03647          the build ranges lie in one buffer with INDIRECT_BUFFER usage
 // Host builds use host addresses: their rules are in build_host.h. Sizes and limits: build_sizes.h.
+#include "buffer_memo.h"
 #include "build_command.h"
+#include "build_memory_pass.h"
 #include "check_context.h"
 
 namespace asval {
 
-// The family entry: the rules above plus those of build_sizes.h.
-bool ValidateBuildAddresses(const CheckContext& ctx, const BuildCommand& cmd);
+// The rules above, plus those of build_sizes.h, for pInfos[i] (called by ValidateBuildMemory).
+bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                           BufferMemo& memo);
 
 }  // namespace asval

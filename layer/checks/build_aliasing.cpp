@@ -4,10 +4,10 @@
 #include <vector>
 
 #include "buffer_lookup.h"
+#include "buffer_memo.h"
 #include "build_report.h"
 #include "build_sizes.h"
 #include "host_instances.h"
-#include "structure_memory.h"
 
 namespace asval {
 
@@ -17,33 +17,34 @@ namespace {
 enum class SpanKind : uint8_t { kDst, kSrc, kScratch, kReferenced };
 
 // Bytes one info accesses: [begin, end) of a VkDeviceMemory (space = its handle), or of the host's address
-// space (host builds' scratch; space = 0).
+// space (host builds' scratch; space = kHostSpace: no VkDeviceMemory handle is 0).
+constexpr uint64_t kHostSpace = 0;
 struct AccessSpan {
   uint64_t space;
   VkDeviceSize begin;
   VkDeviceSize end;
+  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
   uint32_t info;
   SpanKind kind;
-  bool host;
-  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
 };
 
+}  // namespace
+
 // Per-thread buffers, reused from call to call so that a steady stream of builds allocates nothing.
-struct Workspace {
+struct AliasingWorkspace {
   std::vector<AccessSpan> spans;
   std::vector<uint32_t> active;
   std::vector<uint64_t> references;
   std::vector<std::pair<uint64_t, uint32_t>> destinations;  // (handle, info), sorted
 };
 
-Workspace& ThreadWorkspace() {
-  thread_local Workspace workspace;
-  return workspace;
-}
+namespace {
+
+using Workspace = AliasingWorkspace;
 
 constexpr int kMaxFindingsPerCall = 16;  // enough to show the pattern; a flood helps nobody
 
-bool SameSpace(const AccessSpan& a, const AccessSpan& b) { return a.host == b.host && a.space == b.space; }
+bool SameSpace(const AccessSpan& a, const AccessSpan& b) { return a.space == b.space; }
 
 // The rule two overlapping spans break, or null when their overlap is allowed. `a` is the span of the lower
 // kind (so pairs are named once).
@@ -87,7 +88,7 @@ const char* KindName(SpanKind kind) {
 }
 
 std::string DescribeSpan(const AccessSpan& s) {
-  if (s.host) return fmt::format("host bytes [0x{:x}, 0x{:x})", s.begin, s.end);
+  if (s.space == kHostSpace) return fmt::format("host bytes [0x{:x}, 0x{:x})", s.begin, s.end);
   return fmt::format("bytes [0x{:x}, 0x{:x}) of VkDeviceMemory 0x{:x}", s.begin, s.end, s.space);
 }
 
@@ -112,59 +113,69 @@ std::string DescribeSpan(const AccessSpan& s) {
 
 // A structure's bytes this build accesses: `accessed` from its start, at most its size. False when the layer
 // does not know where they are (unknown structure or buffer, not bound).
-bool StructureSpan(const DeviceState& state, VkAccelerationStructureKHR handle, VkDeviceSize accessed, uint32_t info,
-                   SpanKind kind, AccessSpan* out) {
-  const std::optional<StructureMemory> memory = MemoryOfStructure(state, handle);
-  if (!memory || !memory->bound()) return false;
-  const VkDeviceSize begin = memory->memory_offset();
-  *out = AccessSpan{reinterpret_cast<uint64_t>(memory->buffer->memory), begin,
-                    SaturatingAdd(begin, std::min(accessed, memory->structure->size)), info, kind, false, handle};
+bool StructureSpan(const AccelerationStructureState& structure, const KnownBuffer& buffer, VkDeviceSize accessed,
+                   uint32_t info, SpanKind kind, AccessSpan* out) {
+  if (!buffer.bound || buffer.memory == VK_NULL_HANDLE) return false;
+  const VkDeviceSize begin = SaturatingAdd(buffer.memory_offset, structure.offset);
+  *out = AccessSpan{reinterpret_cast<uint64_t>(buffer.memory), begin,
+                    SaturatingAdd(begin, std::min(accessed, structure.size)), structure.handle, info, kind};
   return true;
 }
 
-bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, VkDeviceSize bytes, AccessSpan* out) {
+// Same, for a structure known by handle only.
+bool StructureSpan(const DeviceState& state, BufferMemo& memo, VkAccelerationStructureKHR handle, VkDeviceSize accessed,
+                   uint32_t info, SpanKind kind, AccessSpan* out) {
+  const std::optional<std::shared_ptr<const AccelerationStructureState>> structure =
+      state.acceleration_structures.find(handle);
+  KnownBuffer buffer;
+  if (!structure || !*structure || !memo.Find(state, (*structure)->buffer, &buffer)) return false;
+  return StructureSpan(**structure, buffer, accessed, info, kind, out);
+}
+
+bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                 BufferMemo& memo, AccessSpan* out) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (cmd.is_host()) {
     const auto address = reinterpret_cast<uint64_t>(info.scratchData.hostAddress);
     if (address == 0) return false;
-    *out = AccessSpan{0, address, SaturatingAdd(address, bytes), i, SpanKind::kScratch, true, VK_NULL_HANDLE};
+    *out = AccessSpan{kHostSpace, address, SaturatingAdd(address, r.scratch_bytes), VK_NULL_HANDLE, i,
+                      SpanKind::kScratch};
     return true;
   }
   const VkDeviceAddress address = info.scratchData.deviceAddress;
-  const std::optional<AddressHit> hit = FindBufferHolding(state, address, bytes, 0);
-  if (!hit) return false;  // not in one buffer: the addresses family reports it
-  const std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(hit->buffer);
-  if (!buffer || !*buffer || !(*buffer)->bound) return false;
-  const VkDeviceSize begin = (*buffer)->memory_offset + (address - hit->base);
-  *out = AccessSpan{reinterpret_cast<uint64_t>((*buffer)->memory), begin, SaturatingAdd(begin, bytes), i,
-                    SpanKind::kScratch, false, VK_NULL_HANDLE};
+  KnownBuffer buffer = r.scratch_buffer;
+  if (!r.scratch_in_storage && !memo.Holding(state, address, r.scratch_bytes, 0, &buffer)) {
+    return false;  // not in one buffer: the addresses family reports it
+  }
+  if (!buffer.bound) return false;
+  const VkDeviceSize begin = SaturatingAdd(buffer.memory_offset, address - buffer.base);
+  *out = AccessSpan{reinterpret_cast<uint64_t>(buffer.memory), begin, SaturatingAdd(begin, r.scratch_bytes),
+                    VK_NULL_HANDLE, i, SpanKind::kScratch};
   return true;
 }
 
 // The spans pInfos[i] accesses. Each one the layer cannot place is left out and counted.
-void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, Workspace& w) {
+void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                  BufferMemo& memo, Workspace& w) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
-  if (!sizes) return;  // counted by SizesOfInfo
-  const bool update = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+  if (!r.sizes) return;  // counted by SizesOfInfo
   AccessSpan span;
-  if (StructureSpan(ctx.state, info.dstAccelerationStructure, sizes->acceleration_structure_size, i, SpanKind::kDst,
-                    &span)) {
+  if (r.dst && r.dst_buffer_known &&
+      StructureSpan(*r.dst, r.dst_buffer, r.sizes->acceleration_structure_size, i, SpanKind::kDst, &span)) {
     w.spans.push_back(span);
   } else {
     CountUnknownState(ctx);
   }
-  if (update && info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    if (StructureSpan(ctx.state, info.srcAccelerationStructure, sizes->acceleration_structure_size, i, SpanKind::kSrc,
-                      &span)) {
+  if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR && info.srcAccelerationStructure != VK_NULL_HANDLE) {
+    if (StructureSpan(ctx.state, memo, info.srcAccelerationStructure, r.sizes->acceleration_structure_size, i,
+                      SpanKind::kSrc, &span)) {
       w.spans.push_back(span);
     } else {
       CountUnknownState(ctx);
     }
   }
-  const VkDeviceSize scratch = update ? sizes->update_scratch_size : sizes->build_scratch_size;
-  if (scratch != 0) {
-    if (ScratchSpan(ctx.state, cmd, i, scratch, &span)) {
+  if (r.scratch_bytes != 0) {
+    if (ScratchSpan(ctx.state, cmd, i, r, memo, &span)) {
       w.spans.push_back(span);
     } else {
       CountUnknownState(ctx);
@@ -178,7 +189,9 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
     for (uint64_t reference : w.references) {
       const auto handle = reinterpret_cast<VkAccelerationStructureKHR>(reference);
       // The whole structure: which of its bytes the build reads is the driver's business.
-      if (StructureSpan(ctx.state, handle, ~VkDeviceSize{0}, i, SpanKind::kReferenced, &span)) w.spans.push_back(span);
+      if (StructureSpan(ctx.state, memo, handle, ~VkDeviceSize{0}, i, SpanKind::kReferenced, &span)) {
+        w.spans.push_back(span);
+      }
     }
   }
 }
@@ -187,7 +200,6 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
 // met is an overlap. With no overlaps the active list holds at most one span, so the sweep is linear.
 bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
   std::sort(w.spans.begin(), w.spans.end(), [](const AccessSpan& x, const AccessSpan& y) {
-    if (x.host != y.host) return x.host < y.host;
     if (x.space != y.space) return x.space < y.space;
     if (x.begin != y.begin) return x.begin < y.begin;
     return x.info < y.info;
@@ -230,7 +242,8 @@ bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& 
                      reinterpret_cast<uint64_t>(dst.structure), DescribeSpan(dst));
 }
 
-bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                            BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE ||
       info.srcAccelerationStructure == info.dstAccelerationStructure) {
@@ -238,8 +251,8 @@ bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, ui
   }
   AccessSpan src, dst;
   const VkDeviceSize whole = ~VkDeviceSize{0};
-  if (!StructureSpan(ctx.state, info.srcAccelerationStructure, whole, i, SpanKind::kSrc, &src) ||
-      !StructureSpan(ctx.state, info.dstAccelerationStructure, whole, i, SpanKind::kDst, &dst)) {
+  if (!r.dst || !r.dst_buffer_known || !StructureSpan(*r.dst, r.dst_buffer, whole, i, SpanKind::kDst, &dst) ||
+      !StructureSpan(ctx.state, memo, info.srcAccelerationStructure, whole, i, SpanKind::kSrc, &src)) {
     CountUnknownState(ctx);
     return false;
   }
@@ -289,17 +302,22 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
 
 }  // namespace
 
-bool ValidateBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd) {
-  if (!cmd.infos) return false;
-  Workspace& w = ThreadWorkspace();
-  w.spans.clear();
-  bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) {
-    CollectSpans(ctx, cmd, i, w);
-    skip |= ValidateUpdateAliasing(ctx, cmd, i);
-  }
-  skip |= SweepOverlaps(ctx, cmd, w);
-  if (cmd.is_host()) skip |= ValidateReferencedDestinations(ctx, cmd, w);
+AliasingSweep::AliasingSweep() : w_([]() -> AliasingWorkspace& {
+  thread_local AliasingWorkspace workspace;
+  return workspace;
+}()) {
+  w_.spans.clear();
+}
+
+bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+                            BufferMemo& memo) {
+  CollectSpans(ctx, cmd, i, r, memo, w_);
+  return ValidateUpdateAliasing(ctx, cmd, i, r, memo);
+}
+
+bool AliasingSweep::Finish(const CheckContext& ctx, const BuildCommand& cmd) {
+  bool skip = SweepOverlaps(ctx, cmd, w_);
+  if (cmd.is_host()) skip |= ValidateReferencedDestinations(ctx, cmd, w_);
   return skip;
 }
 

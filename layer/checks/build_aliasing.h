@@ -14,11 +14,29 @@
 // all as the driver reports them for this build. They are compared as VkDeviceMemory offsets, so two buffers
 // over one allocation alias. The spans are sorted and swept once: O(n log n) for n infos, no all-pairs loop.
 // In-place updates (src == dst) are valid: an info's destination and its own source may be the same bytes.
+#include "buffer_memo.h"
 #include "build_command.h"
+#include "build_memory_pass.h"
 #include "check_context.h"
 
 namespace asval {
 
-bool ValidateBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd);
+struct AliasingWorkspace;
+
+// One command's sweep (called by ValidateBuildMemory): AddInfo for each info, then Finish. Uses this thread's
+// reusable buffers, so a steady stream of calls allocates nothing.
+class AliasingSweep {
+ public:
+  AliasingSweep();
+  // Collects the spans pInfos[i] accesses (each one the layer cannot place is left out and counted) and
+  // checks pInfos-03668 for it.
+  bool AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+               BufferMemo& memo);
+  // The overlaps among all the spans; for host builds, None-03407.
+  bool Finish(const CheckContext& ctx, const BuildCommand& cmd);
+
+ private:
+  AliasingWorkspace& w_;
+};
 
 }  // namespace asval

@@ -46,7 +46,7 @@ bool ValidateTriangles(const CheckContext& ctx, const BuildCommand& cmd, uint32_
   const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
   if (alignment.bytes == 0) {
     CountUnknownState(ctx);  // vertexFormat-03797 speaks about such a format
-  } else if (tri.vertexStride % alignment.bytes != 0) {
+  } else if ((tri.vertexStride & (alignment.bytes - 1)) != 0) {
     skip |= ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureGeometryTrianglesDataKHR-vertexStride-03735",
                         [&](std::string&) { return TrianglesField(cmd, i, j, "vertexStride"); },
                         "({}) is not a multiple of {} bytes, the {} of vertexFormat {}.", tri.vertexStride,
@@ -67,7 +67,7 @@ bool ValidateTriangles(const CheckContext& ctx, const BuildCommand& cmd, uint32_
 bool ValidateAabbs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                    const VkAccelerationStructureGeometryAabbsDataKHR& aabbs) {
   bool skip = false;
-  if (aabbs.stride % 8 != 0) {
+  if ((aabbs.stride & 7) != 0) {
     skip |= ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureGeometryAabbsDataKHR-stride-03545",
                         [&](std::string&) { return AabbsField(cmd, i, j, "stride"); }, "({}) is not a multiple of 8.",
                         aabbs.stride);

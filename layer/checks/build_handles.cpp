@@ -13,6 +13,9 @@ namespace {
 
 using AsRecord = std::shared_ptr<const AccelerationStructureState>;
 
+// Up to this many infos the duplicate rules compare all pairs (n^2 / 2 compares, no buffer); beyond, they sort.
+constexpr uint32_t kFewInfos = 16;
+
 AsRecord FindStructure(const CheckContext& ctx, VkAccelerationStructureKHR handle) {
   if (handle == VK_NULL_HANDLE) return nullptr;
   std::optional<AsRecord> record = ctx.state.acceleration_structures.find(handle);
@@ -44,6 +47,7 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
 // vkQueueBindSparse, which the layer does not follow) are skipped and counted.
 bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const AccelerationStructureState& as,
                    const char* vuid, const char* field) {
+  if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup
   const std::optional<std::shared_ptr<const BufferState>> buffer = ctx.state.buffers.find(as.buffer);
   if (!buffer || !*buffer || ((*buffer)->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
     CountUnknownState(ctx);
@@ -108,8 +112,33 @@ using DstEntry = std::pair<VkAccelerationStructureKHR, uint32_t>;
                      reinterpret_cast<uint64_t>(cmd.infos[i].srcAccelerationStructure), other);
 }
 
-// dstAccelerationStructure-03698 and pInfos-03403, by sorting the destinations once.
-bool ValidateDistinctHandles(const CheckContext& ctx, const BuildCommand& cmd) {
+// dstAccelerationStructure-03698 and pInfos-03403 for a few infos: comparing every pair is cheaper than
+// sorting. Reports the same pairs as the sorted version (each against the lowest other index).
+bool ValidateDistinctHandlesFew(const CheckContext& ctx, const BuildCommand& cmd) {
+  bool skip = false;
+  for (uint32_t k = 1; k < cmd.info_count; ++k) {
+    const VkAccelerationStructureKHR dst = cmd.infos[k].dstAccelerationStructure;
+    if (!dst) continue;
+    for (uint32_t m = 0; m < k; ++m) {
+      if (cmd.infos[m].dstAccelerationStructure != dst) continue;
+      skip |= ReportSharedDestination(ctx, cmd, m, k);
+      break;
+    }
+  }
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureKHR src = cmd.infos[i].srcAccelerationStructure;
+    if (!src) continue;
+    for (uint32_t j = 0; j < cmd.info_count; ++j) {
+      if (j == i || cmd.infos[j].dstAccelerationStructure != src) continue;
+      skip |= ReportSourceIsOtherDestination(ctx, cmd, i, j);
+      break;
+    }
+  }
+  return skip;
+}
+
+// dstAccelerationStructure-03698 and pInfos-03403 for many infos, by sorting the destinations once.
+bool ValidateDistinctHandlesMany(const CheckContext& ctx, const BuildCommand& cmd) {
   thread_local std::vector<DstEntry> sorted;  // reused: no allocation once it has grown
   sorted.clear();
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
@@ -143,7 +172,11 @@ bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.infos) return false;
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i);
-  if (cmd.info_count > 1) skip |= ValidateDistinctHandles(ctx, cmd);
+  if (cmd.info_count > kFewInfos) {
+    skip |= ValidateDistinctHandlesMany(ctx, cmd);
+  } else if (cmd.info_count > 1) {
+    skip |= ValidateDistinctHandlesFew(ctx, cmd);
+  }
   return skip;
 }
 

@@ -92,15 +92,35 @@ bool ValidateStructureMemory(const CheckContext& ctx, const BuildCommand& cmd, V
                      update ? "update" : "build", needed, update ? "updateScratchSize" : "buildScratchSize");
 }
 
+[[gnu::cold, gnu::noinline]] bool ReportScratchPastMapping(const CheckContext& ctx, const BuildCommand& cmd,
+                                                           uint32_t i, bool update, VkDeviceSize needed,
+                                                           uintptr_t begin, uintptr_t end) {
+  const std::optional<HostMapping> mapping = ctx.state.host_mappings.Containing(begin);
+  return ReportBuild(ctx, cmd, i, update ? "pInfos-03726" : "pInfos-03725",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("scratchData").Field("hostAddress"); },
+                     "(0x{:x}) points into the mapping of VkDeviceMemory 0x{:x} (host range [0x{:x}, 0x{:x}){}), but "
+                     "this {} needs {} bytes of scratch ({}), {} bytes more than the mapped memory holds from there.",
+                     begin, reinterpret_cast<uint64_t>(mapping ? mapping->memory : VK_NULL_HANDLE),
+                     mapping ? mapping->begin : begin, end,
+                     mapping && mapping->end != end ? ", with the mappings that follow it" : "",
+                     update ? "update" : "build", needed, update ? "updateScratchSize" : "buildScratchSize",
+                     needed - (end - begin));
+}
+
 bool ValidateHostScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  if (info.scratchData.hostAddress != nullptr) return false;
   const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
   if (!sizes) return false;  // counted: without the size, a null pointer may be all a zero-size scratch needs
   const bool update = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
   const VkDeviceSize needed = update ? sizes->update_scratch_size : sizes->build_scratch_size;
   if (needed == 0) return false;
-  return ReportNullScratch(ctx, cmd, i, update, needed);
+  if (info.scratchData.hostAddress == nullptr) return ReportNullScratch(ctx, cmd, i, update, needed);
+  // Where the pointer lies in memory the app mapped, the scratch must fit in the mapping (or mappings that
+  // continue it); elsewhere the layer cannot know how much memory is behind the pointer.
+  const auto begin = reinterpret_cast<uintptr_t>(info.scratchData.hostAddress);
+  const uintptr_t end = ctx.state.host_mappings.ContiguousEnd(begin);
+  if (end == 0 || needed <= end - begin) return false;
+  return ReportScratchPastMapping(ctx, cmd, i, update, needed, begin, end);
 }
 
 [[gnu::cold, gnu::noinline]] bool ReportNullInput(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,

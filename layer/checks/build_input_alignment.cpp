@@ -21,7 +21,7 @@ bool ValidateTriangleAddresses(const CheckContext& ctx, const BuildCommand& cmd,
   const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
   if (alignment.bytes == 0) {
     CountUnknownState(ctx);
-  } else if (tri.vertexData.deviceAddress % alignment.bytes != 0) {
+  } else if ((tri.vertexData.deviceAddress & (alignment.bytes - 1)) != 0) {
     skip |= ReportBuild(ctx, cmd, i, "pInfos-03711", AddressField(cmd, i, j, "triangles", "vertexData"),
                         "(0x{:x}) is not aligned to {} bytes, the {} of vertexFormat {}.",
                         tri.vertexData.deviceAddress, alignment.bytes,
@@ -29,12 +29,12 @@ bool ValidateTriangleAddresses(const CheckContext& ctx, const BuildCommand& cmd,
                         string_VkFormat(tri.vertexFormat));
   }
   const int index_size = IndexTypeSize(tri.indexType);
-  if (index_size > 1 && tri.indexData.deviceAddress % index_size != 0) {
+  if (index_size > 1 && (tri.indexData.deviceAddress & (index_size - 1)) != 0) {
     skip |= ReportBuild(ctx, cmd, i, "pInfos-03712", AddressField(cmd, i, j, "triangles", "indexData"),
                         "(0x{:x}) is not aligned to {} bytes, the size of indexType {}.", tri.indexData.deviceAddress,
                         index_size, string_VkIndexType(tri.indexType));
   }
-  if (tri.transformData.deviceAddress % 16 != 0) {
+  if ((tri.transformData.deviceAddress & 15) != 0) {
     skip |= ReportBuild(ctx, cmd, i, "pInfos-03810", AddressField(cmd, i, j, "triangles", "transformData"),
                         "(0x{:x}) is not aligned to 16 bytes.", tri.transformData.deviceAddress);
   }
@@ -48,7 +48,7 @@ bool ValidateGeometryAddresses(const CheckContext& ctx, const BuildCommand& cmd,
       return ValidateTriangleAddresses(ctx, cmd, i, j, geometry.geometry.triangles);
     case VK_GEOMETRY_TYPE_AABBS_KHR: {
       const VkDeviceAddress address = geometry.geometry.aabbs.data.deviceAddress;
-      if (address % 8 == 0) return false;
+      if ((address & 7) == 0) return false;
       return ReportBuild(ctx, cmd, i, "pInfos-03714", AddressField(cmd, i, j, "aabbs", "data"),
                          "(0x{:x}) is not aligned to 8 bytes.", address);
     }
@@ -56,7 +56,7 @@ bool ValidateGeometryAddresses(const CheckContext& ctx, const BuildCommand& cmd,
       const VkAccelerationStructureGeometryInstancesDataKHR& instances = geometry.geometry.instances;
       const VkDeviceAddress address = instances.data.deviceAddress;
       const uint32_t alignment = instances.arrayOfPointers ? 8 : 16;
-      if (address % alignment == 0) return false;
+      if ((address & (alignment - 1)) == 0) return false;
       return ReportBuild(ctx, cmd, i, instances.arrayOfPointers ? "pInfos-03716" : "pInfos-03715",
                          AddressField(cmd, i, j, "instances", "data"),
                          "(0x{:x}) is not aligned to {} bytes (arrayOfPointers is {}).", address, alignment,
@@ -71,12 +71,12 @@ bool ValidateGeometryAddresses(const CheckContext& ctx, const BuildCommand& cmd,
 bool ValidateIndirectArrays(const CheckContext& ctx, const BuildCommand& cmd) {
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
-    if (cmd.indirect_addresses && cmd.indirect_addresses[i] % 4 != 0) {
+    if (cmd.indirect_addresses && (cmd.indirect_addresses[i] & 3) != 0) {
       skip |= ReportBuild(ctx, cmd, i, "pIndirectDeviceAddresses-03648",
                           [&](std::string&) { return cmd.Root().Field("pIndirectDeviceAddresses", i); },
                           "(0x{:x}) is not a multiple of 4.", cmd.indirect_addresses[i]);
     }
-    if (cmd.indirect_strides && cmd.indirect_strides[i] % 4 != 0) {
+    if (cmd.indirect_strides && (cmd.indirect_strides[i] & 3) != 0) {
       skip |= ReportBuild(ctx, cmd, i, "pIndirectStrides-03787",
                           [&](std::string&) { return cmd.Root().Field("pIndirectStrides", i); },
                           "({}) is not a multiple of 4.", cmd.indirect_strides[i]);

@@ -66,7 +66,7 @@ bool ValidateNonIndexedRange(const CheckContext& ctx, const BuildCommand& cmd, u
   const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
   if (alignment.bytes == 0) {
     CountUnknownState(ctx);
-  } else if (range.primitiveOffset % alignment.bytes != 0) {
+  } else if ((range.primitiveOffset & (alignment.bytes - 1)) != 0) {
     skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03657"), RangeField(cmd, i, j, "primitiveOffset"),
                         "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
                         range.primitiveOffset, alignment.bytes,
@@ -103,7 +103,7 @@ bool ValidateTriangleRange(const CheckContext& ctx, const BuildCommand& cmd, uin
   if (index_size == 0) {
     skip |= ValidateNonIndexedRange(ctx, cmd, i, j, tri, range);
   } else if (index_size == 2 || index_size == 4) {
-    if (range.primitiveOffset % index_size != 0) {
+    if ((range.primitiveOffset & (index_size - 1)) != 0) {
       skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03656"), RangeField(cmd, i, j, "primitiveOffset"),
                           "({}) is not a multiple of {}, the size of the geometry's indexType {}.",
                           range.primitiveOffset, index_size, string_VkIndexType(tri.indexType));
@@ -113,7 +113,7 @@ bool ValidateTriangleRange(const CheckContext& ctx, const BuildCommand& cmd, uin
     }
   }
   // Other index types are indexType-03798's finding; their ranges are not judged.
-  if (range.transformOffset % 16 != 0) {
+  if ((range.transformOffset & 15) != 0) {
     skip |= ReportBuild(ctx, cmd, i, RangeVuid("transformOffset-03658"), RangeField(cmd, i, j, "transformOffset"),
                         "({}) is not a multiple of 16.", range.transformOffset);
   }
@@ -127,12 +127,12 @@ bool ValidateRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
       return ValidateTriangleRange(ctx, cmd, i, j, geometry.geometry.triangles, range);
     case VK_GEOMETRY_TYPE_AABBS_KHR:
-      if (range.primitiveOffset % 8 == 0) return false;
+      if ((range.primitiveOffset & 7) == 0) return false;
       return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03659"), RangeField(cmd, i, j, "primitiveOffset"),
                          "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
                          range.primitiveOffset);
     case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-      if (range.primitiveOffset % 16 == 0) return false;
+      if ((range.primitiveOffset & 15) == 0) return false;
       return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03660"), RangeField(cmd, i, j, "primitiveOffset"),
                          "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
                          range.primitiveOffset);

@@ -143,24 +143,20 @@ bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, ui
                      cmd.is_indirect() ? "ppMaxPrimitiveCounts" : "primitive counts", counts, needed - created);
 }
 
-bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                             const std::optional<BuildSizes>& sizes) {
-  if (!sizes) return false;  // counted by SizesOfInfo
-  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  const std::optional<std::shared_ptr<const AccelerationStructureState>> dst =
-      ctx.state.acceleration_structures.find(info.dstAccelerationStructure);
-  if (!dst || !*dst) {
+bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
+  if (!r.sizes) return false;  // counted by SizesOfInfo
+  if (!r.dst) {
     CountUnknownState(ctx);  // not a live structure: dstAccelerationStructure-03800 says so
     return false;
   }
-  if ((*dst)->size >= sizes->acceleration_structure_size) return false;
-  if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
+  if (r.dst->size >= r.sizes->acceleration_structure_size) return false;
+  if (cmd.infos[i].mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
     // An update may write a compacted structure, smaller than the build size (the rule's second branch):
     // whether dst came from a compacting copy is history the layer does not have here.
     CountUnknownState(ctx);
     return false;
   }
-  return ReportDestinationTooSmall(ctx, cmd, i, (*dst)->size, sizes->acceleration_structure_size);
+  return ReportDestinationTooSmall(ctx, cmd, i, r.dst->size, r.sizes->acceleration_structure_size);
 }
 
 }  // namespace
@@ -231,9 +227,8 @@ std::optional<BuildSizes> SizesOfInfo(const CheckContext& ctx, const BuildComman
   return std::nullopt;
 }
 
-bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                       const std::optional<BuildSizes>& sizes) {
-  return ValidateInstanceCounts(ctx, cmd, i) | ValidateDestinationSize(ctx, cmd, i, sizes);
+bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
+  return ValidateInstanceCounts(ctx, cmd, i) | ValidateDestinationSize(ctx, cmd, i, r);
 }
 
 }  // namespace asval

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "build_command.h"
+#include "build_memory_pass.h"
 #include "build_size_cache.h"
 #include "check_context.h"
 
@@ -29,8 +30,7 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
 // they cannot be known: counts not given, or the query would not be valid (see SizeQueryIsValid).
 std::optional<BuildSizes> SizesOfInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i);
 
-// pInfos-10126 / pInfos-03652 and pInfos-03801 for pInfos[i], all three commands; sizes from SizesOfInfo.
-bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                       const std::optional<BuildSizes>& sizes);
+// pInfos-10126 / pInfos-03652 and pInfos-03801 for pInfos[i], all three commands.
+bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r);
 
 }  // namespace asval

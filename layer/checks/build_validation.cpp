@@ -1,11 +1,10 @@
 #include "build_validation.h"
 
-#include "build_addresses.h"
 #include "build_alignment.h"
-#include "build_aliasing.h"
 #include "build_features.h"
 #include "build_handles.h"
 #include "build_host.h"
+#include "build_memory_pass.h"
 #include "build_ranges.h"
 #include "build_structure.h"
 #include "history_record.h"
@@ -28,8 +27,8 @@ constexpr BuildFamily kBuildFamilies[] = {
     {kCheckStructure, &ValidateBuildRanges},
     {kCheckAlignment, &ValidateBuildAlignment},
     {kCheckHistory, &ValidateBuildHistory},  // host builds only; device builds are checked at submission
-    {kCheckAddresses, &ValidateBuildAddresses},
-    {kCheckAliasing, &ValidateBuildAliasing},
+    // Addresses and aliasing share one pass: each info's sizes, destination and scratch are looked up once.
+    {kCheckAddressesOrAliasing, &ValidateBuildMemory},
     {kCheckHost, &ValidateBuildHost},
 };
 

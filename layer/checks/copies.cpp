@@ -17,17 +17,23 @@ void CountUnknown(const CheckContext& ctx) {
   ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
 }
 
-// "VUID-<function>-<suffix>" for command-level rules, or a structure's VUID as given.
-std::string CommandVuid(const char* function, const char* suffix) {
-  return std::string("VUID-") + function + "-" + suffix;
-}
+// A VUID named without allocating: a structure's whole VUID, or a command's rule as (function, suffix), which
+// becomes "VUID-<function>-<suffix>" only when reported.
+struct VuidName {
+  const char* whole_or_function;
+  const char* suffix = nullptr;
+  std::string str() const {
+    return suffix ? std::string("VUID-") + whole_or_function + "-" + suffix : std::string(whole_or_function);
+  }
+};
 
 template <typename... Args>
 [[gnu::cold, gnu::noinline]] bool Report(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStructureKHR as,
-                                         const std::string& vuid, const Location& loc,
+                                         const VuidName& vuid, const Location& loc,
                                          fmt::format_string<Args...> format, Args&&... args) {
-  return ctx.reporter.Report(Severity::kError, vuid, loc,
-                             {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, as)},
+  return ctx.reporter.Report(Severity::kError, vuid.str(), loc,
+                             {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb),
+                              Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, as)},
                              fmt::format(format, std::forward<Args>(args)...));
 }
 
@@ -45,7 +51,7 @@ Bound StructureBufferBound(const CheckContext& ctx, VkAccelerationStructureKHR a
   return (*buffer)->bound ? Bound::kYes : Bound::kNo;
 }
 
-bool CheckBound(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStructureKHR as, const std::string& vuid,
+bool CheckBound(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStructureKHR as, const VuidName& vuid,
                 const Location& loc) {
   VkBuffer buffer = VK_NULL_HANDLE;
   switch (StructureBufferBound(ctx, as, &buffer)) {
@@ -59,7 +65,7 @@ bool CheckBound(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStruc
 }
 
 bool CheckSerializedAlignment(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStructureKHR as,
-                              const std::string& vuid, const Location& loc, VkDeviceAddress address) {
+                              const VuidName& vuid, const Location& loc, VkDeviceAddress address) {
   if (address % kSerializedDataAlignment == 0) return false;
   return Report(ctx, cb, as, vuid, loc, "(0x{:x}) is not aligned to 256 bytes; it is {} bytes past a multiple of 256.",
                 address, address % kSerializedDataAlignment);
@@ -80,19 +86,21 @@ bool ValidateCopyInfo(const CheckContext& ctx, const char* function, VkCommandBu
   bool skip = false;
   if (info.mode != VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR &&
       info.mode != VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR) {
-    skip |= Report(ctx, cb, info.src, "VUID-VkCopyAccelerationStructureInfoKHR-mode-03410", loc.Field("mode"),
+    skip |= Report(ctx, cb, info.src, VuidName{"VUID-VkCopyAccelerationStructureInfoKHR-mode-03410"}, loc.Field("mode"),
                    "is {}; a copy between structures must be VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR or "
                    "VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR.",
                    string_VkCopyAccelerationStructureModeKHR(info.mode));
   }
-  skip |= CheckBound(ctx, cb, info.src, "VUID-VkCopyAccelerationStructureInfoKHR-buffer-03718", loc.Field("src"));
-  skip |= CheckBound(ctx, cb, info.dst, "VUID-VkCopyAccelerationStructureInfoKHR-buffer-03719", loc.Field("dst"));
+  skip |= CheckBound(ctx, cb, info.src, VuidName{"VUID-VkCopyAccelerationStructureInfoKHR-buffer-03718"},
+                     loc.Field("src"));
+  skip |= CheckBound(ctx, cb, info.dst, VuidName{"VUID-VkCopyAccelerationStructureInfoKHR-buffer-03719"},
+                     loc.Field("dst"));
   const std::optional<MemorySpan> src = AccelerationStructureSpan(ctx.state, info.src);
   const std::optional<MemorySpan> dst = AccelerationStructureSpan(ctx.state, info.dst);
   if (!src || !dst) {
     CountUnknown(ctx);
   } else if (Overlaps(*src, *dst)) {
-    skip |= Report(ctx, cb, info.dst, "VUID-VkCopyAccelerationStructureInfoKHR-dst-07791", loc.Field("dst"),
+    skip |= Report(ctx, cb, info.dst, VuidName{"VUID-VkCopyAccelerationStructureInfoKHR-dst-07791"}, loc.Field("dst"),
                    "(VkAccelerationStructureKHR {}) occupies bytes [{}, {}) of VkDeviceMemory {}, which overlap the "
                    "bytes [{}, {}) that src (VkAccelerationStructureKHR {}) occupies.",
                    Hex(info.dst), dst->begin, dst->end, Hex(dst->memory), src->begin, src->end, Hex(info.src));
@@ -105,12 +113,13 @@ bool ValidateCopyToMemoryInfo(const CheckContext& ctx, const char* function, VkC
   const Location loc = Location(function).Field("pInfo");
   bool skip = false;
   if (info.mode != VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR) {
-    skip |= Report(ctx, cb, info.src, "VUID-VkCopyAccelerationStructureToMemoryInfoKHR-mode-03412", loc.Field("mode"),
+    skip |= Report(ctx, cb, info.src, VuidName{"VUID-VkCopyAccelerationStructureToMemoryInfoKHR-mode-03412"},
+                   loc.Field("mode"),
                    "is {}; a copy to memory must be VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR.",
                    string_VkCopyAccelerationStructureModeKHR(info.mode));
   }
   if (cb) {
-    skip |= CheckSerializedAlignment(ctx, cb, info.src, CommandVuid(function, "pInfo-03740"),
+    skip |= CheckSerializedAlignment(ctx, cb, info.src, VuidName{function, "pInfo-03740"},
                                      loc.Field("dst").Field("deviceAddress"), info.dst.deviceAddress);
   }
   return skip;
@@ -121,12 +130,13 @@ bool ValidateCopyMemoryToInfo(const CheckContext& ctx, const char* function, VkC
   const Location loc = Location(function).Field("pInfo");
   bool skip = false;
   if (info.mode != VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR) {
-    skip |= Report(ctx, cb, info.dst, "VUID-VkCopyMemoryToAccelerationStructureInfoKHR-mode-03413", loc.Field("mode"),
+    skip |= Report(ctx, cb, info.dst, VuidName{"VUID-VkCopyMemoryToAccelerationStructureInfoKHR-mode-03413"},
+                   loc.Field("mode"),
                    "is {}; a copy from memory must be VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR.",
                    string_VkCopyAccelerationStructureModeKHR(info.mode));
   }
   if (cb) {
-    skip |= CheckSerializedAlignment(ctx, cb, info.dst, CommandVuid(function, "pInfo-03743"),
+    skip |= CheckSerializedAlignment(ctx, cb, info.dst, VuidName{function, "pInfo-03743"},
                                      loc.Field("src").Field("deviceAddress"), info.src.deviceAddress);
   }
   return skip;
@@ -138,18 +148,18 @@ bool ValidateWriteProperties(const CheckContext& ctx, const char* function, VkCo
   const Location root(function);
   bool skip = false;
   if (!IsPropertyQueryType(type)) {
-    skip |= Report(ctx, cb, VK_NULL_HANDLE, CommandVuid(function, "queryType-06742"), root.Field("queryType"),
+    skip |= Report(ctx, cb, VK_NULL_HANDLE, VuidName{function, "queryType-06742"}, root.Field("queryType"),
                    "is {}, which is not an acceleration-structure property query type.", string_VkQueryType(type));
   }
   if (!cb) return skip;  // the rest concern the query pool and device execution
   if (std::optional<QueryPoolState> pool_state = ctx.state.history.query_pools.find(pool)) {
     if (pool_state->type != type) {
-      skip |= Report(ctx, cb, VK_NULL_HANDLE, CommandVuid(function, "queryPool-02493"), root.Field("queryPool"),
+      skip |= Report(ctx, cb, VK_NULL_HANDLE, VuidName{function, "queryPool-02493"}, root.Field("queryPool"),
                      "(VkQueryPool {}) was created with queryType {}, not the queryType {} of this command.", Hex(pool),
                      string_VkQueryType(pool_state->type), string_VkQueryType(type));
     }
     if (uint64_t{first_query} + count > pool_state->count) {
-      skip |= Report(ctx, cb, VK_NULL_HANDLE, CommandVuid(function, "query-04880"), root.Field("firstQuery"),
+      skip |= Report(ctx, cb, VK_NULL_HANDLE, VuidName{function, "query-04880"}, root.Field("firstQuery"),
                      "({}) plus accelerationStructureCount ({}) is {}, more than the {} queries of VkQueryPool {}.",
                      first_query, count, uint64_t{first_query} + count, pool_state->count, Hex(pool));
     }
@@ -157,7 +167,7 @@ bool ValidateWriteProperties(const CheckContext& ctx, const char* function, VkCo
     CountUnknown(ctx);
   }
   for (uint32_t i = 0; structures && i < count; ++i) {
-    skip |= CheckBound(ctx, cb, structures[i], CommandVuid(function, "buffer-03736"),
+    skip |= CheckBound(ctx, cb, structures[i], VuidName{function, "buffer-03736"},
                        root.Field("pAccelerationStructures", i));
   }
   return skip;

@@ -105,7 +105,8 @@ void RecordDeviceBuild(DeviceState& state, uint32_t enabled, const BuildCommand&
   const OpCommand command = cmd.is_indirect() ? OpCommand::kCmdBuildIndirect : OpCommand::kCmdBuild;
   const OpOrigin origin = DeviceOrigin(*log, command, cmd.command_buffer);
   // Indirect builds: the ranges (and so the primitive counts) are on the device.
-  Guarded(*log, [&] { log->batch.AppendBuilds(origin, cmd.info_count, cmd.infos, cmd.is_indirect() ? nullptr : cmd.ranges); });
+  const VkAccelerationStructureBuildRangeInfoKHR* const* ranges = cmd.is_indirect() ? nullptr : cmd.ranges;
+  Guarded(*log, [&] { log->batch.AppendBuilds(origin, cmd.info_count, cmd.infos, ranges); });
 }
 
 void RecordDeviceCopy(DeviceState& state, uint32_t enabled, VkCommandBuffer cb,
@@ -268,7 +269,9 @@ void RecordHostSerializationSizes(DeviceState& state, uint32_t count, const VkAc
   for (uint32_t i = 0; i < count; ++i) {
     uint64_t size = 0;
     std::memcpy(&size, static_cast<const unsigned char*>(data) + i * stride, sizeof(size));
-    if (const AsHistory* h = store.Find(structures[i])) RecordSerializationSize(store, structures[i], h->generation, size);
+    if (const AsHistory* h = store.Find(structures[i])) {
+      RecordSerializationSize(store, structures[i], h->generation, size);
+    }
   }
 }
 

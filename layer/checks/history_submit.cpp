@@ -26,6 +26,7 @@ void SubmitHistory::Apply(VkCommandBuffer cb, const Location& loc) {
   }
   const HistoryCheckSite site{loc, cb, true};
   const OpBatch& batch = log->batch;
+  txn_.ReserveMore(batch.ops().size() * 2);  // one entry per written structure, and some clobbers
   for (const AsOp& op : batch.ops()) {
     CheckOpHistory(state_, store, enabled_, batch, op, site, findings_);
     ApplyOp(state_, store, batch, op, &txn_);

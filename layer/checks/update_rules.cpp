@@ -45,7 +45,8 @@ struct OpReporter {
   [[gnu::cold, gnu::noinline]] void Add(Severity severity, std::string vuid, VkAccelerationStructureKHR subject,
                                         std::string message) const {
     out.Add(severity, std::move(vuid), Where(),
-            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, subject),
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted),
+             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, subject),
              Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, op.dst == subject ? VK_NULL_HANDLE : op.dst)},
             Prefix() + message);
   }
@@ -57,25 +58,30 @@ struct OpReporter {
 };
 
 // The history of a structure an operation reads, or nothing (skip counted) when it cannot be judged: a handle
-// the layer does not know as a live structure (another family's rule), or an unknown history.
+// the layer does not know as a live structure (another family's rule), or an unknown history. A structure
+// with a record is live (records end when structures are destroyed), so only one without needs the lookup.
 const AsHistory* ReadableHistory(const OpReporter& r, VkAccelerationStructureKHR as, AsHistory* storage) {
-  if (!r.state.acceleration_structures.contains(as)) {
+  const AsHistory* h = r.store.Find(as);
+  if (!h) {
+    if (!r.state.acceleration_structures.contains(as)) {
+      r.CountSkip();
+      return nullptr;
+    }
+    *storage = r.store.Get(as);  // never built, or unknown after lost operations
+    h = storage;
+  }
+  if (h->kind == HistoryKind::kUnknown) {
     r.CountSkip();
     return nullptr;
   }
-  *storage = r.store.Get(as);
-  if (storage->kind == HistoryKind::kUnknown) {
-    r.CountSkip();
-    return nullptr;
-  }
-  return storage;
+  return h;
 }
 
 [[gnu::cold, gnu::noinline]] void ReportClobbered(const OpReporter& r, VkAccelerationStructureKHR as,
                                                   const AsHistory& h, const char* use) {
   const Clobber& c = *h.clobbered;
-  const std::string writer =
-      c.writer ? fmt::format("writing VkAccelerationStructureKHR {}", Hex(c.writer)) : std::string("writing serialized data");
+  const std::string writer = c.writer ? fmt::format("writing VkAccelerationStructureKHR {}", Hex(c.writer))
+                                      : std::string("writing serialized data");
   r.Add(Severity::kWarning, kClobberedId, as,
         fmt::format("{} VkAccelerationStructureKHR {} after its memory was overwritten: {} ({}) wrote memory that "
                     "overlaps it after it was last built. Its contents are no longer what was built; rebuild it "
@@ -100,7 +106,8 @@ std::string LastBuilt(const OpReporter& r, const BuildSnapshot& s) {
   const AsOp& op = r.op;
   if (!(s.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR)) {
     r.Add(Severity::kError, r.CommandVuid("pInfos-03667"), op.src,
-          fmt::format("is an update, but {} with flags {}, without VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR.",
+          fmt::format("is an update, but {} with flags {}, without "
+                      "VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR.",
                       LastBuilt(r, s), BuildFlagsText(s.flags)));
   }
   if (s.geometries.size() != op.geometry_count) {

@@ -101,7 +101,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkD
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
-    VkDevice device, VkDeferredOperationKHR deferredOperation, const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
+    VkDevice device, VkDeferredOperationKHR deferredOperation,
+    const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(device);
   const char* function = "vkCopyAccelerationStructureToMemoryKHR";
   if (!pInfo) return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo);
@@ -112,7 +113,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CopyMemoryToAccelerationStructureKHR(
-    VkDevice device, VkDeferredOperationKHR deferredOperation, const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
+    VkDevice device, VkDeferredOperationKHR deferredOperation,
+    const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(device);
   const char* function = "vkCopyMemoryToAccelerationStructureKHR";
   if (!pInfo) return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo);

@@ -1,5 +1,6 @@
 #include "build_size_cache.h"
 
+#include <cstring>
 #include <mutex>
 
 namespace asval {
@@ -55,6 +56,19 @@ struct HashSink {
   }
 };
 
+// Hashes the words and keeps the first kLocalWords of them for a word-by-word compare.
+struct BufferedSink {
+  uint64_t words[BuildSizeCache::kLocalWords];
+  std::size_t count = 0;
+  HashSink hash;
+  void operator()(uint64_t w) {
+    if (count < BuildSizeCache::kLocalWords) words[count] = w;
+    ++count;
+    hash(w);
+  }
+  bool buffered() const { return count <= BuildSizeCache::kLocalWords; }
+};
+
 struct CompareSink {
   const std::vector<uint64_t>& words;
   std::size_t next = 0;
@@ -70,16 +84,37 @@ struct StoreSink {
   void operator()(uint64_t w) { words.push_back(w); }
 };
 
-uint64_t HashOf(const BuildSignature& s) {
-  HashSink sink;
-  EmitSignature(s, sink);
-  // fmix64: spread the last words into the high bits, which pick the shard.
-  uint64_t h = sink.h;
+// fmix64: spread the last words into the high bits (which pick the shard) and the low ones (the slot of the
+// per-thread table).
+uint64_t Finish(uint64_t h) {
   h ^= h >> 33;
   h *= 0xff51afd7ed558ccdull;
   h ^= h >> 33;
   return h;
 }
+
+uint64_t HashOf(const BuildSignature& s) {
+  HashSink sink;
+  EmitSignature(s, sink);
+  return Finish(sink.h);
+}
+
+// The per-thread table: direct-mapped, one signature per slot.
+struct LocalEntry {
+  uint64_t cache_id = 0;  // 0: empty (cache ids start at 1)
+  uint64_t hash = 0;
+  std::size_t count = 0;
+  uint64_t words[BuildSizeCache::kLocalWords];
+  BuildSizes sizes;
+};
+constexpr std::size_t kLocalSlots = 64;
+
+LocalEntry& LocalSlot(uint64_t hash) {
+  thread_local LocalEntry table[kLocalSlots];
+  return table[hash & (kLocalSlots - 1)];
+}
+
+std::atomic<uint64_t> g_next_cache_id{1};
 
 }  // namespace
 
@@ -108,16 +143,49 @@ bool BuildSignature::Cacheable() const {
   return true;
 }
 
+BuildSizeCache::BuildSizeCache() : id_(g_next_cache_id.fetch_add(1, std::memory_order_relaxed)) {}
+
+void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count,
+                                     const BuildSizes& sizes) const {
+  if (count > kLocalWords) return;
+  LocalEntry& slot = LocalSlot(hash);
+  slot.cache_id = id_;
+  slot.hash = hash;
+  slot.count = count;
+  std::memcpy(slot.words, words, count * sizeof(uint64_t));
+  slot.sizes = sizes;
+}
+
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) const {
-  const uint64_t hash = HashOf(signature);
+  BufferedSink sink;
+  EmitSignature(signature, sink);
+  const uint64_t hash = Finish(sink.hash.h);
+  if (sink.buffered()) {
+    const LocalEntry& slot = LocalSlot(hash);
+    if (slot.cache_id == id_ && slot.hash == hash && slot.count == sink.count &&
+        std::memcmp(slot.words, sink.words, sink.count * sizeof(uint64_t)) == 0) {
+      *out = slot.sizes;
+      return true;
+    }
+  }
   const Shard& shard = ShardFor(hash);
-  std::shared_lock lock(shard.mutex);
-  const auto it = shard.map.find(hash);
-  if (it == shard.map.end()) return false;
-  CompareSink compare{it->second.words};
-  EmitSignature(signature, compare);
-  if (!compare.equal || compare.next != it->second.words.size()) return false;
-  *out = it->second.sizes;
+  {
+    std::shared_lock lock(shard.mutex);
+    const auto it = shard.map.find(hash);
+    if (it == shard.map.end()) return false;
+    const std::vector<uint64_t>& stored = it->second.words;
+    if (sink.buffered()) {
+      if (stored.size() != sink.count || std::memcmp(stored.data(), sink.words, sink.count * sizeof(uint64_t)) != 0) {
+        return false;
+      }
+    } else {
+      CompareSink compare{stored};
+      EmitSignature(signature, compare);
+      if (!compare.equal || compare.next != stored.size()) return false;
+    }
+    *out = it->second.sizes;
+  }
+  if (sink.buffered()) RememberLocally(hash, sink.words, sink.count, *out);
   return true;
 }
 
@@ -152,6 +220,7 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   StoreSink store{entry.words};
   EmitSignature(signature, store);
   const uint64_t hash = HashOf(signature);
+  RememberLocally(hash, entry.words.data(), entry.words.size(), sizes);
   Shard& shard = ShardFor(hash);
   std::unique_lock lock(shard.mutex);
   if (shard.map.size() >= kMaxEntriesPerShard) shard.map.clear();
@@ -171,6 +240,7 @@ std::size_t BuildSizeCache::size() const {
 }
 
 void BuildSizeCache::Clear() {
+  id_ = g_next_cache_id.fetch_add(1, std::memory_order_relaxed);  // every per-thread entry is now foreign
   for (Shard& shard : shards_) {
     std::unique_lock lock(shard.mutex);
     shard.map.clear();

@@ -9,9 +9,11 @@
 // geometry's type, flags, formats, strides, maxVertex, index type, transform presence, instance layout and
 // primitive count), and nothing they do not (addresses, handles, mode: the driver ignores those).
 //
-// A hit hashes the signature, takes one shard's shared lock and compares the stored signature word by word
-// (so a hash collision can never return another build's sizes): no allocation, no driver call. A miss asks
-// the driver through the next layer's dispatch and stores the answer.
+// A hit hashes the signature and compares a stored copy word by word (so a hash collision can never return
+// another build's sizes): no allocation, no driver call. Signatures of up to kLocalWords words (builds of up
+// to two geometries) are first looked up in a small per-thread table, which needs no lock at all; the rest,
+// and per-thread misses, take one shard's shared lock. A miss of both asks the driver through the next
+// layer's dispatch and stores the answer.
 //
 // Thread safety: Find/Query may run concurrently on any threads; Init runs once at device creation, before
 // another thread can see the device.
@@ -58,7 +60,7 @@ class BuildSizeCache {
  public:
   using QueryFn = PFN_vkGetAccelerationStructureBuildSizesKHR;
 
-  BuildSizeCache() = default;
+  BuildSizeCache();
   BuildSizeCache(const BuildSizeCache&) = delete;
   BuildSizeCache& operator=(const BuildSizeCache&) = delete;
 
@@ -81,7 +83,11 @@ class BuildSizeCache {
   // Driver queries made so far (each lookup that missed and was answered). Hits are lookups minus these.
   uint64_t queries() const { return queries_.load(std::memory_order_relaxed); }
   std::size_t size() const;
+  // Forgets every answer (the per-thread tables too). Not concurrent with Find/Query.
   void Clear();
+
+  // Signatures of at most this many words also live in the per-thread table.
+  static constexpr std::size_t kLocalWords = 16;
 
   // A shard holds at most this many signatures; a full shard is emptied (apps whose counts change every
   // frame would otherwise grow the cache without bound).
@@ -100,6 +106,12 @@ class BuildSizeCache {
 
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
+  // Stores a hit in the calling thread's table.
+  void RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count, const BuildSizes& sizes) const;
+
+  // Names this cache's entries in the per-thread tables; never reused, so an entry of a destroyed device's
+  // cache can never answer for another device.
+  uint64_t id_;
   VkDevice device_ = VK_NULL_HANDLE;
   QueryFn query_ = nullptr;
   mutable std::array<Shard, kShardCount> shards_;

@@ -125,7 +125,8 @@ class OpBatch {
   void Clear();
 
   // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
-  void AppendBuilds(const OpOrigin& origin, uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+  void AppendBuilds(const OpOrigin& origin, uint32_t info_count,
+                    const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
   // Any other operation (no geometries).
   void Append(const AsOp& op) { ops_.push_back(op); }

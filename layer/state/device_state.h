@@ -13,6 +13,7 @@
 #include "concurrent_map.h"
 #include "history_state.h"
 #include "format_features.h"
+#include "host_mappings.h"
 #include "objects.h"
 
 namespace asval {
@@ -51,6 +52,8 @@ class DeviceState {
   HistoryState history;
   // vkGetAccelerationStructureBuildSizesKHR answers by build signature (the size and aliasing rules).
   BuildSizeCache build_sizes;
+  // Host pointers from vkMapMemory (host builds' scratch must fit in what the app mapped).
+  HostMappings host_mappings;
   // Command pools and buffers: level and protected-ness (commandBuffer-09547).
   CommandBufferLevels command_buffer_levels;
   // Buffer format features, asked of the driver once per format (vertexFormat-03797).

@@ -29,15 +29,27 @@ class FormatFeatureCache {
   // a format these headers do not name (an extension newer than the layer: the driver may know it, but the
   // question would be invalid usage for the layer's own headers, and guessing is worse than skipping).
   std::optional<VkFormatFeatureFlags> BufferFeatures(VkFormat format) const {
+    const auto value = static_cast<uint32_t>(format);
+    if (value < kCoreFormatCount) {
+      const uint64_t slot = core_[value].load(std::memory_order_relaxed);
+      if (slot != 0) return static_cast<VkFormatFeatureFlags>(slot & 0xffffffffu);
+    }
+    return FirstLookup(format);
+  }
+
+ private:
+  // VK_FORMAT_UNDEFINED .. VK_FORMAT_ASTC_12x12_SRGB_BLOCK: the contiguous core 1.0 range.
+  static constexpr uint32_t kCoreFormatCount = VK_FORMAT_ASTC_12x12_SRGB_BLOCK + 1;
+  static constexpr uint64_t kQueried = uint64_t{1} << 32;
+
+  // Everything but a cached core format: the first question about a format, and extension formats.
+  [[gnu::noinline]] std::optional<VkFormatFeatureFlags> FirstLookup(VkFormat format) const {
     if (!query_) return std::nullopt;
     const auto value = static_cast<uint32_t>(format);
     if (value < kCoreFormatCount) {
-      uint64_t slot = core_[value].load(std::memory_order_relaxed);
-      if (slot == 0) {
-        // Two threads may both ask the first time; they store the same answer.
-        slot = kQueried | Query(format);
-        core_[value].store(slot, std::memory_order_relaxed);
-      }
+      // Two threads may both ask the first time; they store the same answer.
+      const uint64_t slot = kQueried | Query(format);
+      core_[value].store(slot, std::memory_order_relaxed);
       return static_cast<VkFormatFeatureFlags>(slot & 0xffffffffu);
     }
     if (std::optional<VkFormatFeatureFlags> cached = extension_formats_.find(format)) return cached;
@@ -46,11 +58,6 @@ class FormatFeatureCache {
     extension_formats_.insert_or_assign(format, features);
     return features;
   }
-
- private:
-  // VK_FORMAT_UNDEFINED .. VK_FORMAT_ASTC_12x12_SRGB_BLOCK: the contiguous core 1.0 range.
-  static constexpr uint32_t kCoreFormatCount = VK_FORMAT_ASTC_12x12_SRGB_BLOCK + 1;
-  static constexpr uint64_t kQueried = uint64_t{1} << 32;
 
   static bool KnownToHeaders(VkFormat format) {
     return std::string_view(string_VkFormat(format)).rfind("VK_FORMAT_", 0) == 0;

@@ -95,6 +95,7 @@ class HistoryStore;
 class Transaction {
  public:
   bool empty() const { return entries_.empty(); }
+  void ReserveMore(std::size_t entries) { entries_.reserve(entries_.size() + entries); }
 
  private:
   friend class HistoryStore;

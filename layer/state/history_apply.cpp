@@ -49,10 +49,17 @@ std::shared_ptr<const BuildSnapshot> UpdateSnapshot(const AsHistory& src, const 
   return MakeSnapshot(batch, op);
 }
 
-// The written structure's new record, with its span, a fresh generation and no clobber.
+// The written structure's new record, with its span, a fresh generation and no clobber. A structure's span
+// never changes while it lives (its buffer's binding is immutable), so a known one is reused rather than
+// looked up again in the shadow maps.
 AsHistory Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
   AsHistory h;
-  if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) h.span = *span;
+  const AsHistory* old = store.Find(as);
+  if (old && old->span.memory != VK_NULL_HANDLE) {
+    h.span = old->span;
+  } else if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) {
+    h.span = *span;
+  }
   h.generation = store.NextGeneration();
   return h;
 }
@@ -100,7 +107,8 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
   AsHistory h = Fresh(state, store, op.dst);
   h.kind = HistoryKind::kBuilt;
   if (op.is_update()) {
-    h.build = UpdateSnapshot(store.Get(op.src), batch, op);
+    const AsHistory* src = store.Find(op.src);
+    h.build = src ? UpdateSnapshot(*src, batch, op) : MakeSnapshot(batch, op);
   } else {
     const AsHistory* old = store.Find(op.dst);
     h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);

@@ -42,6 +42,9 @@ struct AccelerationStructureState {
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR;
   VkAccelerationStructureCreateFlagsKHR create_flags = 0;
   VkDeviceAddress device_address = 0;  // the layer queries it at creation when the device allows it
+  // The buffer was bound to memory when the structure was created. A binding never goes away, so the
+  // bound-memory rules (pInfos-03707/03708) need no buffer lookup for such a structure.
+  bool buffer_was_bound = false;
 };
 
 }  // namespace asval

@@ -38,7 +38,10 @@ void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, 
   state.memories.insert_or_assign(memory, std::move(record));
 }
 
-void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) { state.memories.erase(memory); }
+void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
+  state.memories.erase(memory);
+  state.host_mappings.Unmap(memory);  // freeing unmaps
+}
 
 void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer) {
   auto record = std::make_shared<BufferState>();
@@ -91,6 +94,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   // The layer asks for the address only where the app itself could (the buffer is bound and has
   // SHADER_DEVICE_ADDRESS usage), so that its own call breaks no rule.
   std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(info.buffer);
+  record->buffer_was_bound = buffer && *buffer && (*buffer)->bound;
   if (buffer && *buffer && (*buffer)->bound && ((*buffer)->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) &&
       dispatch.GetAccelerationStructureDeviceAddressKHR) {
     const VkAccelerationStructureDeviceAddressInfoKHR address_info{

@@ -94,66 +94,93 @@ TEST_CASE("scratchData-03704: scratch in two different buffers over one VkDevice
   CHECK(f.monitor().Verify() == "");
 }
 
-TEST_CASE("dstAccelerationStructure-03702 / 03703: destinations over the same memory, and over scratch",
-          "[integration][aliasing][03702][03703]") {
+TEST_CASE("dstAccelerationStructure-03702: two destinations over the same memory, for the three commands",
+          "[integration][aliasing][03702]") {
   CheckFixture f("aliasing");
   vkkit::Device& device = f.device();
   Scene scene(device);
   TriangleInfos builds(scene, 2);
   const VkDeviceSize size = DriverSizes(device, builds.infos[0], {1}).accelerationStructureSize;
   SharedMemory memory(device, 1 << 16);
-  vkkit::Buffer storage = memory.Bind(0, 8192, kAsStorage | kStorage);
-  const Command command = GENERATE(Command::kDirect, Command::kIndirect);
+  vkkit::Buffer storage = memory.Bind(0, 8192, kAsStorage);
+  const Command command = GENERATE(Command::kDirect, Command::kIndirect, Command::kHost);
   INFO(CommandName(command));
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos = builds.infos;
-  {
-    SECTION("03702: two structures at the same offset of one buffer") {
-      infos[0].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
-      infos[1].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
-      f.monitor().Expect(kDstDst.For(command));
-    }
-    SECTION("03703: a destination over its own scratch") {
-      infos[0].dstAccelerationStructure = memory.Structure(storage, 1024, size, kBottom);
-      infos[0].scratchData.deviceAddress = storage.address + 1024;
-      f.monitor().Expect(kDstScratch.For(command));
-    }
-    IssueWithRealRanges(device, command, infos, builds.ranges);
-    CHECK(f.monitor().Verify() == "");
-  }
+  // Two structures at the same offset of one buffer (distinct handles: dstAccelerationStructure-03698 is
+  // the handles family's).
+  infos[0].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
+  infos[1].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
+  f.monitor().Expect(kDstDst.For(command));
+  IssueWithRealRanges(device, command, infos, builds.ranges);
+  CHECK(f.monitor().Verify() == "");
 }
 
-TEST_CASE("scratchData-03705 / dstAccelerationStructure-03701 / pInfos-03668: updates whose source is overlapped",
-          "[integration][aliasing][03705][03701][03668]") {
+TEST_CASE("dstAccelerationStructure-03703: a destination over its own scratch", "[integration][aliasing][03703]") {
   CheckFixture f("aliasing");
   vkkit::Device& device = f.device();
   Scene scene(device);
-  TriangleInfos builds(scene, 2);
+  TriangleInfos builds(scene, 1);
   const VkDeviceSize size = DriverSizes(device, builds.infos[0], {1}).accelerationStructureSize;
   SharedMemory memory(device, 1 << 16);
   vkkit::Buffer storage = memory.Bind(0, 8192, kAsStorage | kStorage);
-  const VkAccelerationStructureKHR source = memory.Structure(storage, 0, size, kBottom);
-  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos = builds.infos;
-  // infos[0] updates `source` into its own destination.
-  infos[0].mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
-  infos[0].srcAccelerationStructure = source;
   const Command command = GENERATE(Command::kDirect, Command::kIndirect);
   INFO(CommandName(command));
-  {
-    SECTION("03705: another info's scratch over the source") {
-      infos[1].scratchData.deviceAddress = storage.address + 64;
-      f.monitor().Expect(kScratchSrc.For(command));
-    }
-    SECTION("03701: another info's destination over the source") {
-      infos[1].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
-      f.monitor().Expect(kDstSrc.For(command));
-    }
-    SECTION("03668: the update's own destination is another structure over the source's memory") {
-      infos[0].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
-      f.monitor().Expect(kUpdateAlias.For(command));
-    }
-    IssueWithRealRanges(device, command, infos, builds.ranges);
-    CHECK(f.monitor().Verify() == "");
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos = builds.infos;
+  infos[0].dstAccelerationStructure = memory.Structure(storage, 1024, size, kBottom);
+  infos[0].scratchData.deviceAddress = storage.address + 1024;
+  f.monitor().Expect(kDstScratch.For(command));
+  IssueWithRealRanges(device, command, infos, builds.ranges);
+  CHECK(f.monitor().Verify() == "");
+}
+
+// infos[0] updates `source` (at offset 0 of a shared buffer) into its own destination; infos[1] is a build.
+struct UpdateOverShared {
+  Scene scene;
+  TriangleInfos builds;
+  VkDeviceSize size;
+  SharedMemory memory;
+  vkkit::Buffer storage;
+  VkAccelerationStructureKHR source;
+  explicit UpdateOverShared(vkkit::Device& device)
+      : scene(device),
+        builds(scene, 2),
+        size(DriverSizes(device, builds.infos[0], {1}).accelerationStructureSize),
+        memory(device, 1 << 16),
+        storage(memory.Bind(0, 8192, kAsStorage | kStorage)),
+        source(memory.Structure(storage, 0, size, kBottom)) {
+    builds.infos[0].mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+    builds.infos[0].srcAccelerationStructure = source;
   }
+};
+
+TEST_CASE("scratchData-03705: another info's scratch over an update's source", "[integration][aliasing][03705]") {
+  CheckFixture f("aliasing");
+  UpdateOverShared u(f.device());
+  const Command command = GENERATE(Command::kDirect, Command::kIndirect);
+  INFO(CommandName(command));
+  u.builds.infos[1].scratchData.deviceAddress = u.storage.address + 64;
+  f.monitor().Expect(kScratchSrc.For(command));
+  IssueWithRealRanges(f.device(), command, u.builds.infos, u.builds.ranges);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("dstAccelerationStructure-03701 / pInfos-03668: destinations over an update's source, for the three "
+          "commands",
+          "[integration][aliasing][03701][03668]") {
+  CheckFixture f("aliasing");
+  UpdateOverShared u(f.device());
+  const Command command = GENERATE(Command::kDirect, Command::kIndirect, Command::kHost);
+  INFO(CommandName(command));
+  SECTION("03701: another info's destination over the source") {
+    u.builds.infos[1].dstAccelerationStructure = u.memory.Structure(u.storage, 0, u.size, kBottom);
+    f.monitor().Expect(kDstSrc.For(command));
+  }
+  SECTION("03668: the update's own destination is another structure over the source's memory") {
+    u.builds.infos[0].dstAccelerationStructure = u.memory.Structure(u.storage, 0, u.size, kBottom);
+    f.monitor().Expect(kUpdateAlias.For(command));
+  }
+  IssueWithRealRanges(f.device(), command, u.builds.infos, u.builds.ranges);
+  CHECK(f.monitor().Verify() == "");
 }
 
 // Host builds read their instances when called: a TLAS instance that references another info's

@@ -1,8 +1,7 @@
 #include "build_state_fixture.h"
 
-#include "build_addresses.h"
-#include "build_aliasing.h"
 #include "build_host.h"
+#include "build_memory_pass.h"
 #include "state_tracker.h"
 #include "vk_dispatch_table.h"
 
@@ -131,8 +130,7 @@ void BuildStateFixture::DestroyStructure(VkAccelerationStructureKHR as) { Record
 
 bool BuildStateFixture::Validate(const BuildCommand& cmd) {
   const CheckContext ctx{state, reporter, kCheckAddresses | kCheckAliasing | kCheckHost};
-  bool skip = ValidateBuildAddresses(ctx, cmd);
-  skip |= ValidateBuildAliasing(ctx, cmd);
+  bool skip = ValidateBuildMemory(ctx, cmd);
   skip |= ValidateBuildHost(ctx, cmd);
   return skip;
 }

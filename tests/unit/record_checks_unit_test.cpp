@@ -129,6 +129,41 @@ TEST_CASE("record checks: the three commands report their own VUID names", "[uni
   CHECK(h.Run(kDirect, {info}, {ranges.data()}).empty());
 }
 
+TEST_CASE("record checks: shared destinations and sources are found the same way in few and many infos",
+          "[unit][record][03698][03403]") {
+  RecordHarness h;
+  Inputs in;
+  const VkAccelerationStructureGeometryKHR triangles = TrianglesAt(Inputs::At(in.vertices));
+  const Ranges ranges(1, VkAccelerationStructureBuildRangeInfoKHR{1, 0, 0, 0});
+  // 10 infos take the pairwise path, 40 the sorted one.
+  for (uint32_t count : {10u, 40u}) {
+    INFO(count << " infos");
+    std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+    for (uint32_t k = 0; k < count; ++k) {
+      infos.push_back(InfoOf(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, &triangles, 1,
+                             h.AddStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR), kScratch + 128 * k));
+    }
+    // Three infos write one structure; one info updates from another's destination; one updates in place.
+    infos[7].dstAccelerationStructure = infos[2].dstAccelerationStructure;
+    infos[9].dstAccelerationStructure = infos[2].dstAccelerationStructure;
+    infos[4].mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+    infos[4].srcAccelerationStructure = infos[8].dstAccelerationStructure;
+    infos[5].mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+    infos[5].srcAccelerationStructure = infos[5].dstAccelerationStructure;
+    CHECK(h.Run(kDirect, infos, Each(ranges, count), kCheckHandles) ==
+          std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03698",
+                                   "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03698",
+                                   "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03403"});
+    REQUIRE(h.texts().size() == 3);
+    CHECK(h.texts()[0].find("pInfos[7].dstAccelerationStructure") != std::string::npos);
+    CHECK(h.texts()[0].find("of pInfos[2]") != std::string::npos);
+    CHECK(h.texts()[1].find("pInfos[9].dstAccelerationStructure") != std::string::npos);
+    CHECK(h.texts()[1].find("of pInfos[2]") != std::string::npos);
+    CHECK(h.texts()[2].find("pInfos[4].srcAccelerationStructure") != std::string::npos);
+    CHECK(h.texts()[2].find("of pInfos[8]") != std::string::npos);
+  }
+}
+
 TEST_CASE("record checks: host builds compare the largest index they read with maxVertex (maxVertex-10774)",
           "[unit][record][10774]") {
   RecordHarness h;

@@ -1,6 +1,7 @@
 #include "gpu.h"
 
 #include <cstring>
+#include <iterator>
 #include <stdexcept>
 #include <vector>
 

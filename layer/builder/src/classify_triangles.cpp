@@ -235,7 +235,7 @@ void ClassifyLoop(const LoopInput& in, Counters& out) {
             const uint8_t* p1 = in.vertices + v1 * in.stride;
             const uint8_t* p2 = in.vertices + v2 * in.stride;
             bool inactive, undefinedInput, degenerate = false;
-            __m128i ka, kb, kc;
+            __m128i ka = _mm_setzero_si128(), kb = ka, kc = ka;  // set on the wide path only
             const bool wide = vmax < simdVertices;  // the SIMD loads read kLoadBytes: only where provided
             if (__builtin_expect(wide, 1)) {
                 int na, nb, nc;

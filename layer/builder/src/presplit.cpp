@@ -219,10 +219,11 @@ Bvh BuildTriangleBvh(const TriangleGeometryView* geometries, size_t geometryCoun
         base += geometries[g].range.primitiveCount;
     }
     const uint32_t added = SplitLargeTriangles(geometries, geometryCount, options, &in);
-    if (excludedCounts) {
+    if (excludedCounts) {  // the counters only: never a copy of the references
+        std::vector<PrimRef> refs = std::move(in.refs);
+        in.refs.clear();
         *excludedCounts = in;
-        excludedCounts->refs.clear();
-        excludedCounts->refs.shrink_to_fit();
+        in.refs = std::move(refs);
     }
     Bvh bvh = BuildBvh(std::move(in), options);
     bvh.stats.splitReferences = added;
