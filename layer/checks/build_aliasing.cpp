@@ -32,6 +32,7 @@ struct AccessSpan {
 
 // Per-thread buffers, reused from call to call so that a steady stream of builds allocates nothing.
 struct AliasingWorkspace {
+  bool in_use = false;
   std::vector<AccessSpan> spans;
   std::vector<uint32_t> active;
   std::vector<uint64_t> references;
@@ -302,22 +303,40 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
 
 }  // namespace
 
-AliasingSweep::AliasingSweep() : w_([]() -> AliasingWorkspace& {
+namespace {
+
+// This thread's workspace, or null while a sweep on this thread already holds it (an app callback that
+// records a build from inside a report): the nested sweep then works in a buffer of its own.
+AliasingWorkspace* TakeThreadWorkspace() {
   thread_local AliasingWorkspace workspace;
-  return workspace;
-}()) {
-  w_.spans.clear();
+  if (workspace.in_use) return nullptr;
+  workspace.in_use = true;
+  return &workspace;
+}
+
+}  // namespace
+
+AliasingSweep::AliasingSweep() : w_(TakeThreadWorkspace()) {
+  if (!w_) {
+    owned_ = std::make_unique<AliasingWorkspace>();
+    w_ = owned_.get();
+  }
+  w_->spans.clear();
+}
+
+AliasingSweep::~AliasingSweep() {
+  if (!owned_) w_->in_use = false;
 }
 
 bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
                             BufferMemo& memo) {
-  CollectSpans(ctx, cmd, i, r, memo, w_);
+  CollectSpans(ctx, cmd, i, r, memo, *w_);
   return ValidateUpdateAliasing(ctx, cmd, i, r, memo);
 }
 
 bool AliasingSweep::Finish(const CheckContext& ctx, const BuildCommand& cmd) {
-  bool skip = SweepOverlaps(ctx, cmd, w_);
-  if (cmd.is_host()) skip |= ValidateReferencedDestinations(ctx, cmd, w_);
+  bool skip = SweepOverlaps(ctx, cmd, *w_);
+  if (cmd.is_host()) skip |= ValidateReferencedDestinations(ctx, cmd, *w_);
   return skip;
 }
 

@@ -14,6 +14,8 @@
 // all as the driver reports them for this build. They are compared as VkDeviceMemory offsets, so two buffers
 // over one allocation alias. The spans are sorted and swept once: O(n log n) for n infos, no all-pairs loop.
 // In-place updates (src == dst) are valid: an info's destination and its own source may be the same bytes.
+#include <memory>
+
 #include "buffer_memo.h"
 #include "build_command.h"
 #include "build_memory_pass.h"
@@ -28,6 +30,9 @@ struct AliasingWorkspace;
 class AliasingSweep {
  public:
   AliasingSweep();
+  ~AliasingSweep();
+  AliasingSweep(const AliasingSweep&) = delete;
+  AliasingSweep& operator=(const AliasingSweep&) = delete;
   // Collects the spans pInfos[i] accesses (each one the layer cannot place is left out and counted) and
   // checks pInfos-03668 for it.
   bool AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
@@ -36,7 +41,8 @@ class AliasingSweep {
   bool Finish(const CheckContext& ctx, const BuildCommand& cmd);
 
  private:
-  AliasingWorkspace& w_;
+  AliasingWorkspace* w_;
+  std::unique_ptr<AliasingWorkspace> owned_;  // only when the thread's workspace is already in use
 };
 
 }  // namespace asval

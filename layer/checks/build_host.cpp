@@ -214,7 +214,7 @@ bool ValidateDeferredOperation(const CheckContext& ctx, const BuildCommand& cmd)
 
 bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.is_host() || !cmd.infos) return false;
-  thread_local std::vector<uint64_t> references;  // reused: instance references of one geometry
+  std::vector<uint64_t> references;  // instance references of one geometry (host builds are not a hot path)
   bool skip = ValidateDeferredOperation(ctx, cmd);
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];

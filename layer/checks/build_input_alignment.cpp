@@ -8,11 +8,58 @@ namespace asval {
 
 namespace {
 
-// "pInfos[i].pGeometries[j].geometry.<kind>.<field>.deviceAddress".
-auto AddressField(const BuildCommand& cmd, uint32_t i, uint32_t j, const char* kind, const char* field) {
-  return [&cmd, i, j, kind, field](std::string&) {
-    return GeometryLocation(cmd, i, j).Field("geometry").Field(kind).Field(field).Field("deviceAddress");
-  };
+// The input addresses these rules cover. The clean path passes only this and two numbers to the reporting
+// half, so it materialises no message pieces (field names, lambdas) in its own frame.
+enum class Input { kVertexData, kIndexData, kTransformData, kAabbData, kInstances, kInstancePointers };
+
+[[gnu::cold, gnu::noinline]] bool ReportMisaligned(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                   uint32_t j, Input input, VkDeviceAddress address,
+                                                   uint32_t alignment) {
+  const VkAccelerationStructureGeometryKHR& g = *GeometryAt(cmd.infos[i], j);
+  const char* vuid = "pInfos-03711";
+  const char* kind = "triangles";
+  const char* field = "vertexData";
+  std::string why;
+  switch (input) {
+    case Input::kVertexData:
+      why = fmt::format(", the {} of vertexFormat {}",
+                        AlignmentOfVertexFormat(g.geometry.triangles.vertexFormat).packed ? "size of the packed format"
+                                                                                          : "component size",
+                        string_VkFormat(g.geometry.triangles.vertexFormat));
+      break;
+    case Input::kIndexData:
+      vuid = "pInfos-03712";
+      field = "indexData";
+      why = fmt::format(", the size of indexType {}", string_VkIndexType(g.geometry.triangles.indexType));
+      break;
+    case Input::kTransformData:
+      vuid = "pInfos-03810";
+      field = "transformData";
+      break;
+    case Input::kAabbData:
+      vuid = "pInfos-03714";
+      kind = "aabbs";
+      field = "data";
+      break;
+    case Input::kInstances:
+      vuid = "pInfos-03715";
+      kind = "instances";
+      field = "data";
+      why = " (arrayOfPointers is VK_FALSE: an array of VkAccelerationStructureInstanceKHR)";
+      break;
+    case Input::kInstancePointers:
+      vuid = "pInfos-03716";
+      kind = "instances";
+      field = "data";
+      why = " (arrayOfPointers is VK_TRUE: an array of pointers)";
+      break;
+  }
+  return ReportBuild(
+      ctx, cmd, i, vuid,
+      [&](std::string&) {
+        return GeometryLocation(cmd, i, j).Field("geometry").Field(kind).Field(field).Field("deviceAddress");
+      },
+      "(0x{:x}) is not aligned to {} bytes{}.", address, alignment, why);
 }
 
 bool ValidateTriangleAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
@@ -22,21 +69,15 @@ bool ValidateTriangleAddresses(const CheckContext& ctx, const BuildCommand& cmd,
   if (alignment.bytes == 0) {
     CountUnknownState(ctx);
   } else if ((tri.vertexData.deviceAddress & (alignment.bytes - 1)) != 0) {
-    skip |= ReportBuild(ctx, cmd, i, "pInfos-03711", AddressField(cmd, i, j, "triangles", "vertexData"),
-                        "(0x{:x}) is not aligned to {} bytes, the {} of vertexFormat {}.",
-                        tri.vertexData.deviceAddress, alignment.bytes,
-                        alignment.packed ? "size of the packed format" : "component size",
-                        string_VkFormat(tri.vertexFormat));
+    skip |= ReportMisaligned(ctx, cmd, i, j, Input::kVertexData, tri.vertexData.deviceAddress, alignment.bytes);
   }
   const int index_size = IndexTypeSize(tri.indexType);
   if (index_size > 1 && (tri.indexData.deviceAddress & (index_size - 1)) != 0) {
-    skip |= ReportBuild(ctx, cmd, i, "pInfos-03712", AddressField(cmd, i, j, "triangles", "indexData"),
-                        "(0x{:x}) is not aligned to {} bytes, the size of indexType {}.", tri.indexData.deviceAddress,
-                        index_size, string_VkIndexType(tri.indexType));
+    skip |= ReportMisaligned(ctx, cmd, i, j, Input::kIndexData, tri.indexData.deviceAddress,
+                             static_cast<uint32_t>(index_size));
   }
   if ((tri.transformData.deviceAddress & 15) != 0) {
-    skip |= ReportBuild(ctx, cmd, i, "pInfos-03810", AddressField(cmd, i, j, "triangles", "transformData"),
-                        "(0x{:x}) is not aligned to 16 bytes.", tri.transformData.deviceAddress);
+    skip |= ReportMisaligned(ctx, cmd, i, j, Input::kTransformData, tri.transformData.deviceAddress, 16);
   }
   return skip;
 }
@@ -49,38 +90,40 @@ bool ValidateGeometryAddresses(const CheckContext& ctx, const BuildCommand& cmd,
     case VK_GEOMETRY_TYPE_AABBS_KHR: {
       const VkDeviceAddress address = geometry.geometry.aabbs.data.deviceAddress;
       if ((address & 7) == 0) return false;
-      return ReportBuild(ctx, cmd, i, "pInfos-03714", AddressField(cmd, i, j, "aabbs", "data"),
-                         "(0x{:x}) is not aligned to 8 bytes.", address);
+      return ReportMisaligned(ctx, cmd, i, j, Input::kAabbData, address, 8);
     }
     case VK_GEOMETRY_TYPE_INSTANCES_KHR: {
       const VkAccelerationStructureGeometryInstancesDataKHR& instances = geometry.geometry.instances;
       const VkDeviceAddress address = instances.data.deviceAddress;
-      const uint32_t alignment = instances.arrayOfPointers ? 8 : 16;
-      if ((address & (alignment - 1)) == 0) return false;
-      return ReportBuild(ctx, cmd, i, instances.arrayOfPointers ? "pInfos-03716" : "pInfos-03715",
-                         AddressField(cmd, i, j, "instances", "data"),
-                         "(0x{:x}) is not aligned to {} bytes (arrayOfPointers is {}).", address, alignment,
-                         instances.arrayOfPointers ? "VK_TRUE: an array of pointers" : "VK_FALSE: an array of "
-                                                                                      "VkAccelerationStructureInstanceKHR");
+      if (instances.arrayOfPointers) {
+        if ((address & 7) == 0) return false;
+        return ReportMisaligned(ctx, cmd, i, j, Input::kInstancePointers, address, 8);
+      }
+      if ((address & 15) == 0) return false;
+      return ReportMisaligned(ctx, cmd, i, j, Input::kInstances, address, 16);
     }
     default:
       return false;
   }
 }
 
+[[gnu::cold, gnu::noinline]] bool ReportIndirectArray(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                      bool stride) {
+  if (stride) {
+    return ReportBuild(ctx, cmd, i, "pIndirectStrides-03787",
+                       [&](std::string&) { return cmd.Root().Field("pIndirectStrides", i); },
+                       "({}) is not a multiple of 4.", cmd.indirect_strides[i]);
+  }
+  return ReportBuild(ctx, cmd, i, "pIndirectDeviceAddresses-03648",
+                     [&](std::string&) { return cmd.Root().Field("pIndirectDeviceAddresses", i); },
+                     "(0x{:x}) is not a multiple of 4.", cmd.indirect_addresses[i]);
+}
+
 bool ValidateIndirectArrays(const CheckContext& ctx, const BuildCommand& cmd) {
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
-    if (cmd.indirect_addresses && (cmd.indirect_addresses[i] & 3) != 0) {
-      skip |= ReportBuild(ctx, cmd, i, "pIndirectDeviceAddresses-03648",
-                          [&](std::string&) { return cmd.Root().Field("pIndirectDeviceAddresses", i); },
-                          "(0x{:x}) is not a multiple of 4.", cmd.indirect_addresses[i]);
-    }
-    if (cmd.indirect_strides && (cmd.indirect_strides[i] & 3) != 0) {
-      skip |= ReportBuild(ctx, cmd, i, "pIndirectStrides-03787",
-                          [&](std::string&) { return cmd.Root().Field("pIndirectStrides", i); },
-                          "({}) is not a multiple of 4.", cmd.indirect_strides[i]);
-    }
+    if (cmd.indirect_addresses && (cmd.indirect_addresses[i] & 3) != 0) skip |= ReportIndirectArray(ctx, cmd, i, false);
+    if (cmd.indirect_strides && (cmd.indirect_strides[i] & 3) != 0) skip |= ReportIndirectArray(ctx, cmd, i, true);
   }
   return skip;
 }

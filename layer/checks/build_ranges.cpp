@@ -10,16 +10,68 @@ namespace asval {
 
 namespace {
 
-constexpr const char* kRangeVuid = "VUID-VkAccelerationStructureBuildRangeInfoKHR-";
+// The range rules, named for the reporting half: the clean path passes only this and indices, so it
+// materialises no message pieces in its own frame.
+enum class RangeRule { kIndexOffset, kVertexOffset, kTransformOffset, kAabbOffset, kInstanceOffset, kVertexCount,
+                       kLastVertex };
 
-std::string RangeVuid(const char* suffix) { return std::string(kRangeVuid) + suffix; }
-
-// "ppBuildRangeInfos[i][j].<field>": a path element with two indices, built at report time.
-auto RangeField(const BuildCommand& cmd, uint32_t i, uint32_t j, const char* field) {
-  return [&cmd, i, j, field](std::string& storage) {
-    storage = fmt::format("ppBuildRangeInfos[{}][{}]", i, j);
-    return cmd.Root().Field(storage.c_str()).Field(field);
+[[gnu::cold, gnu::noinline]] bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                                              RangeRule rule) {
+  const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
+  const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
+  // "ppBuildRangeInfos[i][j].<field>": a path element with two indices, built here.
+  const auto range_field = [&cmd, i, j](const char* field) {
+    return [&cmd, i, j, field](std::string& storage) {
+      storage = fmt::format("ppBuildRangeInfos[{}][{}]", i, j);
+      return cmd.Root().Field(storage.c_str()).Field(field);
+    };
   };
+  const auto max_vertex = [&](std::string&) {
+    return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
+  };
+  const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
+  switch (rule) {
+    case RangeRule::kIndexOffset:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656",
+                         range_field("primitiveOffset"), "({}) is not a multiple of {}, the size of the geometry's "
+                         "indexType {}.",
+                         range.primitiveOffset, IndexTypeSize(tri.indexType), string_VkIndexType(tri.indexType));
+    case RangeRule::kVertexOffset: {
+      const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657",
+                         range_field("primitiveOffset"),
+                         "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
+                         range.primitiveOffset, alignment.bytes,
+                         alignment.packed ? "size of the packed format" : "component size",
+                         string_VkFormat(tri.vertexFormat));
+    }
+    case RangeRule::kTransformOffset:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-transformOffset-03658",
+                         range_field("transformOffset"), "({}) is not a multiple of 16.", range.transformOffset);
+    case RangeRule::kAabbOffset:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03659",
+                         range_field("primitiveOffset"),
+                         "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
+                         range.primitiveOffset);
+    case RangeRule::kInstanceOffset:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03660",
+                         range_field("primitiveOffset"),
+                         "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
+                         range.primitiveOffset);
+    case RangeRule::kVertexCount:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-vertexData-10418",
+                         range_field("primitiveCount"),
+                         "({}) triangles consume {} vertices from vertexData, more than the geometry's maxVertex "
+                         "({}) + 1.",
+                         range.primitiveCount, vertices, tri.maxVertex);
+    case RangeRule::kLastVertex:
+      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-None-10775", max_vertex,
+                         "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) + primitiveCount ({}) * 3 - 1 "
+                         "= {}, the last vertex the non-indexed build reads.",
+                         tri.maxVertex, i, j, range.firstVertex, range.primitiveCount,
+                         uint64_t{range.firstVertex} + vertices - 1);
+  }
+  return false;
 }
 
 // The largest of `count` indices of `size` bytes at `data` (which need not be aligned).
@@ -41,6 +93,20 @@ uint32_t LargestIndex(const uint8_t* data, uint64_t count, int size) {
   return largest;
 }
 
+[[gnu::cold, gnu::noinline]] bool ReportLargestIndex(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                     uint32_t j, uint32_t largest) {
+  const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
+  const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
+  return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-maxVertex-10774",
+                     [&](std::string&) {
+                       return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
+                     },
+                     "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) plus the largest index the "
+                     "build reads ({}, among the {} {} indices at indexData.hostAddress + primitiveOffset {}).",
+                     tri.maxVertex, i, j, range.firstVertex, largest, uint64_t{range.primitiveCount} * 3,
+                     string_VkIndexType(tri.indexType), range.primitiveOffset);
+}
+
 // maxVertex-10774 for a host build: the indices are in host memory now, so the largest can be read.
 bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                                 const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
@@ -49,14 +115,7 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
   const auto* data = static_cast<const uint8_t*>(tri.indexData.hostAddress) + range.primitiveOffset;
   const uint32_t largest = LargestIndex(data, uint64_t{range.primitiveCount} * 3, index_size);
   if (uint64_t{range.firstVertex} + largest <= tri.maxVertex) return false;
-  return ReportBuild(ctx, cmd, i, RangeVuid("maxVertex-10774"),
-                     [&](std::string&) {
-                       return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
-                     },
-                     "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) plus the largest index the "
-                     "build reads ({}, among the {} {} indices at indexData.hostAddress + primitiveOffset {}).",
-                     tri.maxVertex, i, j, range.firstVertex, largest, uint64_t{range.primitiveCount} * 3,
-                     string_VkIndexType(tri.indexType), range.primitiveOffset);
+  return ReportLargestIndex(ctx, cmd, i, j, largest);
 }
 
 bool ValidateNonIndexedRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
@@ -67,30 +126,14 @@ bool ValidateNonIndexedRange(const CheckContext& ctx, const BuildCommand& cmd, u
   if (alignment.bytes == 0) {
     CountUnknownState(ctx);
   } else if ((range.primitiveOffset & (alignment.bytes - 1)) != 0) {
-    skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03657"), RangeField(cmd, i, j, "primitiveOffset"),
-                        "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
-                        range.primitiveOffset, alignment.bytes,
-                        alignment.packed ? "size of the packed format" : "component size",
-                        string_VkFormat(tri.vertexFormat));
+    skip |= ReportRange(ctx, cmd, i, j, RangeRule::kVertexOffset);
   }
   // Nothing is read when there are no triangles (firstVertex then names no vertex).
   if (range.primitiveCount == 0) return skip;
   const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
-  if (vertices > uint64_t{tri.maxVertex} + 1) {
-    skip |= ReportBuild(ctx, cmd, i, RangeVuid("vertexData-10418"), RangeField(cmd, i, j, "primitiveCount"),
-                        "({}) triangles consume {} vertices from vertexData, more than the geometry's maxVertex ({}) "
-                        "+ 1.",
-                        range.primitiveCount, vertices, tri.maxVertex);
-  }
+  if (vertices > uint64_t{tri.maxVertex} + 1) skip |= ReportRange(ctx, cmd, i, j, RangeRule::kVertexCount);
   if (uint64_t{range.firstVertex} + vertices - 1 > tri.maxVertex) {
-    skip |= ReportBuild(ctx, cmd, i, RangeVuid("None-10775"),
-                        [&](std::string&) {
-                          return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
-                        },
-                        "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) + primitiveCount ({}) * 3 - 1 "
-                        "= {}, the last vertex the non-indexed build reads.",
-                        tri.maxVertex, i, j, range.firstVertex, range.primitiveCount,
-                        uint64_t{range.firstVertex} + vertices - 1);
+    skip |= ReportRange(ctx, cmd, i, j, RangeRule::kLastVertex);
   }
   return skip;
 }
@@ -104,19 +147,14 @@ bool ValidateTriangleRange(const CheckContext& ctx, const BuildCommand& cmd, uin
     skip |= ValidateNonIndexedRange(ctx, cmd, i, j, tri, range);
   } else if (index_size == 2 || index_size == 4) {
     if ((range.primitiveOffset & (index_size - 1)) != 0) {
-      skip |= ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03656"), RangeField(cmd, i, j, "primitiveOffset"),
-                          "({}) is not a multiple of {}, the size of the geometry's indexType {}.",
-                          range.primitiveOffset, index_size, string_VkIndexType(tri.indexType));
+      skip |= ReportRange(ctx, cmd, i, j, RangeRule::kIndexOffset);
     } else if (cmd.is_host()) {
       // Indices read from a misaligned offset are not the app's indices: only an aligned range is judged.
       skip |= ValidateIndexedVertexCount(ctx, cmd, i, j, tri, range, index_size);
     }
   }
   // Other index types are indexType-03798's finding; their ranges are not judged.
-  if ((range.transformOffset & 15) != 0) {
-    skip |= ReportBuild(ctx, cmd, i, RangeVuid("transformOffset-03658"), RangeField(cmd, i, j, "transformOffset"),
-                        "({}) is not a multiple of 16.", range.transformOffset);
-  }
+  if ((range.transformOffset & 15) != 0) skip |= ReportRange(ctx, cmd, i, j, RangeRule::kTransformOffset);
   return skip;
 }
 
@@ -128,14 +166,10 @@ bool ValidateRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
       return ValidateTriangleRange(ctx, cmd, i, j, geometry.geometry.triangles, range);
     case VK_GEOMETRY_TYPE_AABBS_KHR:
       if ((range.primitiveOffset & 7) == 0) return false;
-      return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03659"), RangeField(cmd, i, j, "primitiveOffset"),
-                         "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
-                         range.primitiveOffset);
+      return ReportRange(ctx, cmd, i, j, RangeRule::kAabbOffset);
     case VK_GEOMETRY_TYPE_INSTANCES_KHR:
       if ((range.primitiveOffset & 15) == 0) return false;
-      return ReportBuild(ctx, cmd, i, RangeVuid("primitiveOffset-03660"), RangeField(cmd, i, j, "primitiveOffset"),
-                         "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
-                         range.primitiveOffset);
+      return ReportRange(ctx, cmd, i, j, RangeRule::kInstanceOffset);
     default:
       return false;  // geometry types of newer extensions have rules of their own
   }

@@ -49,14 +49,18 @@ std::shared_ptr<const BuildSnapshot> UpdateSnapshot(const AsHistory& src, const 
   return MakeSnapshot(batch, op);
 }
 
-// The written structure's new record, with its span, a fresh generation and no clobber. A structure's span
-// never changes while it lives (its buffer's binding is immutable), so a known one is reused rather than
-// looked up again in the shadow maps.
-AsHistory Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
+// The written structure's new record, with its span, a fresh generation and no clobber; nullopt for a handle
+// that is not a live structure (destroyed before the command buffer was submitted: an invalid submission whose
+// record would otherwise outlive the structure and greet a new one with the same handle value). A structure's
+// span never changes while it lives (its buffer's binding is immutable), so a known one is reused rather than
+// looked up again in the shadow maps; records end when structures are destroyed, so one with a record lives.
+std::optional<AsHistory> Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
   AsHistory h;
   const AsHistory* old = store.Find(as);
   if (old && old->span.memory != VK_NULL_HANDLE) {
     h.span = old->span;
+  } else if (!old && !state.acceleration_structures.contains(as)) {
+    return std::nullopt;
   } else if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) {
     h.span = *span;
   }
@@ -104,7 +108,9 @@ void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h
 
 void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
                 Transaction* txn) {
-  AsHistory h = Fresh(state, store, op.dst);
+  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  if (!fresh) return;
+  AsHistory& h = *fresh;
   h.kind = HistoryKind::kBuilt;
   if (op.is_update()) {
     const AsHistory* src = store.Find(op.src);
@@ -118,7 +124,9 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
 
 void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
   const AsHistory src = store.Get(op.src);
-  AsHistory h = Fresh(state, store, op.dst);
+  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  if (!fresh) return;
+  AsHistory& h = *fresh;
   if (src.kind == HistoryKind::kBuilt) {
     h.kind = HistoryKind::kBuilt;
     h.build = src.build;
@@ -162,7 +170,9 @@ void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn) {
 }
 
 void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
-  AsHistory h = Fresh(state, store, op.dst);
+  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  if (!fresh) return;
+  AsHistory& h = *fresh;
   const SerializedBlob* blob = nullptr;
   if (op.memory.host_address) {
     const SerializedBlob* candidate = store.FindHostBlob(op.memory.host_address);

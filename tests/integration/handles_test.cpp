@@ -87,15 +87,20 @@ struct UnboundStructure {
   VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
 };
 
+// The handle of a structure that was live once, destroyed (with its buffer) before the build.
+VkAccelerationStructureKHR DestroyedStructure(vkkit::Device& device) {
+  vkkit::AccelerationStructure as = device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 4096);
+  const VkAccelerationStructureKHR handle = as.handle;
+  device.Destroy(as);
+  return handle;
+}
+
 TEST_CASE("03800: a destination that is not a live structure is reported by all three commands",
           "[integration][handles][03800]") {
   CheckFixture f("handles");
   Scene scene(f.device());
   TriangleInfo t(scene);
-  // A handle that was live once: destroyed before the build.
-  const VkAccelerationStructureKHR destroyed = f.device().CreateAccelerationStructure(
-      VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 4096).handle;
-  f.device().DestroyAccelerationStructureKHR(f.device().handle(), destroyed, nullptr);
+  const VkAccelerationStructureKHR destroyed = DestroyedStructure(f.device());
   const auto ranges = Ranges(1);
   for (VkAccelerationStructureKHR dst : {destroyed, VkAccelerationStructureKHR(VK_NULL_HANDLE)}) {
     t.info.dstAccelerationStructure = dst;
@@ -113,9 +118,7 @@ TEST_CASE("04629: a source that is not a live structure is reported by all three
   CheckFixture f("handles");
   Scene scene(f.device());
   TriangleInfo t(scene);
-  const VkAccelerationStructureKHR destroyed = f.device().CreateAccelerationStructure(
-      VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 4096).handle;
-  f.device().DestroyAccelerationStructureKHR(f.device().handle(), destroyed, nullptr);
+  const VkAccelerationStructureKHR destroyed = DestroyedStructure(f.device());
   t.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
   t.info.srcAccelerationStructure = destroyed;
   const auto ranges = Ranges(1);

@@ -43,7 +43,8 @@ TEST_CASE("history: updating a structure whose memory another build overwrote is
   CHECK(f.monitor().Verify() == "");
 }
 
-TEST_CASE("history valid twin: separate memory, or a rebuild after the overwrite, stays silent (ASVAL-History-Clobbered)",
+TEST_CASE("history valid twin: separate memory, or a rebuild after the overwrite, stays silent "
+          "(ASVAL-History-Clobbered)",
           "[integration][history]") {
   HistoryFixture f;
   vkkit::Device& device = f.device();

@@ -140,7 +140,8 @@ TEST_CASE("history valid twin: copying a structure built earlier in the same sub
     commands.Barrier(cb);
     CmdCopy(device, cb, src.handle(), dst.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
     commands.Barrier(cb);
-    CmdCopy(device, cb, dst.handle(), dst2.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);  // a copy of a copy
+    // A copy of a copy.
+    CmdCopy(device, cb, dst.handle(), dst2.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
   });
   CHECK(f.monitor().Verify() == "");
 }
@@ -220,8 +221,9 @@ TEST_CASE("history: host property queries and copies are checked when called (04
   uint64_t value = 0;
   VkAccelerationStructureKHR handle = never_built.handle();
   f.monitor().Expect("VUID-vkWriteAccelerationStructuresPropertiesKHR-pAccelerationStructures-04964");
-  CHECK(procs.HostWriteProperties(device.handle(), 1, &handle, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR,
-                                  sizeof(value), &value, sizeof(value)) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(procs.HostWriteProperties(device.handle(), 1, &handle,
+                                  VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, sizeof(value), &value,
+                                  sizeof(value)) == VK_ERROR_VALIDATION_FAILED_EXT);
   CHECK(f.monitor().Verify() == "");
   handle = built.handle();
   f.monitor().Expect("VUID-vkWriteAccelerationStructuresPropertiesKHR-accelerationStructures-03431");
@@ -261,7 +263,8 @@ TEST_CASE("history: deserializing bytes the layer saw serialized restores the hi
   Inputs inputs(device);
   Blas original(device, inputs), restored(device, inputs);
   Serialized s = BuildAndSerialize(device, original, Shape{});
-  Submit(device, [&](Commands&, VkCommandBuffer cb) { CmdDeserialize(device, cb, s.bytes.address, restored.handle()); });
+  Submit(device,
+         [&](Commands&, VkCommandBuffer cb) { CmdDeserialize(device, cb, s.bytes.address, restored.handle()); });
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758");
   Shape two;
   two.geometries = 2;
@@ -304,8 +307,9 @@ TEST_CASE("history: deserializing bytes the layer did not see written leaves the
         VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
         barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
         barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
-                             1, &barrier, 0, nullptr, 0, nullptr);
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0, 1, &barrier, 0, nullptr, 0,
+                             nullptr);
         CmdDeserialize(device, cb, elsewhere.address, restored.handle());
       });
       // Unknown history: the update is not judged (it is valid here; an invalid one would be just as silent).

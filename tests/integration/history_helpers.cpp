@@ -52,8 +52,9 @@ Commands::Commands(vkkit::Device& device) : device_(device) {
   vkkit::Check(vkCreateCommandPool(device.handle(), &info, nullptr, &pool_), "vkCreateCommandPool");
 }
 
+// Nothing is pending here: Submit waits for the queue (and skipped submissions never ran). Not waiting again
+// keeps the destructors off the queue, which threads share under the app's lock only.
 Commands::~Commands() {
-  vkQueueWaitIdle(device_.queue());
   if (!buffers_.empty()) {
     vkFreeCommandBuffers(device_.handle(), pool_, static_cast<uint32_t>(buffers_.size()), buffers_.data());
   }
@@ -93,7 +94,8 @@ void Commands::End(VkCommandBuffer cb) { vkkit::Check(vkEndCommandBuffer(cb), "v
 void Commands::Barrier(VkCommandBuffer cb) {
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
-  barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  barrier.dstAccessMask =
+      VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
                        VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
@@ -227,7 +229,6 @@ void Blas::Create() {
 }
 
 Blas::~Blas() {
-  vkQueueWaitIdle(device_.queue());
   if (handle_) device_.DestroyAccelerationStructureKHR(device_.handle(), handle_, nullptr);
   device_.Destroy(scratch_);
   device_.Destroy(storage_);
@@ -289,14 +290,13 @@ Tlas::Tlas(vkkit::Device& device) : device_(device), procs_(device) {
 }
 
 Tlas::~Tlas() {
-  vkQueueWaitIdle(device_.queue());
   device_.Destroy(as_);
   device_.Destroy(scratch_);
 }
 
 vkkit::Buffer Tlas::MakeInstances(const std::vector<const Blas*>& blases) {
-  vkkit::Buffer buffer = device_.CreateBuffer(sizeof(VkAccelerationStructureInstanceKHR) * std::max<size_t>(1, blases.size()),
-                                              kInputUsage);
+  const size_t count = std::max<size_t>(1, blases.size());
+  vkkit::Buffer buffer = device_.CreateBuffer(sizeof(VkAccelerationStructureInstanceKHR) * count, kInputUsage);
   for (size_t i = 0; i < blases.size(); ++i) {
     VkAccelerationStructureInstanceKHR instance{};
     instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
@@ -344,8 +344,9 @@ void QueryPool::Reset(VkCommandBuffer cb) { vkCmdResetQueryPool(cb, pool_, 0, co
 
 std::vector<uint64_t> QueryPool::Results() {
   std::vector<uint64_t> results(count_);
+  const VkQueryResultFlags flags = VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT;
   vkkit::Check(vkGetQueryPoolResults(device_.handle(), pool_, 0, count_, results.size() * sizeof(uint64_t),
-                                     results.data(), sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                                     results.data(), sizeof(uint64_t), flags),
                "vkGetQueryPoolResults");
   return results;
 }

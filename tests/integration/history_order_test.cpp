@@ -221,7 +221,8 @@ TEST_CASE("history valid twin: builds and updates in secondary command buffers s
   CHECK(f.monitor().Verify() == "");
 }
 
-TEST_CASE("history: vkQueueSubmit2 applies and checks like vkQueueSubmit", "[integration][history][passes-invalid-down]") {
+TEST_CASE("history: vkQueueSubmit2 applies and checks like vkQueueSubmit",
+          "[integration][history][passes-invalid-down]") {
   HistoryFixture f("history");
   vkkit::Device& device = f.device();
   Procs procs(device);

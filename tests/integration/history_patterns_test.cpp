@@ -75,7 +75,8 @@ TEST_CASE("history pattern: many infos per call, then their updates in one call,
   std::vector<vkkit::Buffer> scratch;
   device.OneShot([&](VkCommandBuffer cb) { scratch = record_all(cb, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR); });
   for (auto& b : scratch) device.Destroy(b);
-  device.OneShot([&](VkCommandBuffer cb) { scratch = record_all(cb, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR); });
+  device.OneShot(
+      [&](VkCommandBuffer cb) { scratch = record_all(cb, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR); });
   for (auto& b : scratch) device.Destroy(b);
   CHECK(f.monitor().Verify() == "");
 }
@@ -95,12 +96,14 @@ TEST_CASE("history pattern: a TLAS updated every frame from a new instance buffe
     barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
     barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR;
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-                         VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+                         VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0, 1, &barrier, 0, nullptr, 0,
+                         nullptr);
     tlas.Record(cb, instances, 2, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
   });
   for (int frame = 0; frame < 4; ++frame) {
     vkkit::Buffer next = tlas.MakeInstances({&b, &a});  // a new buffer (a new address) each frame
-    device.OneShot([&](VkCommandBuffer cb) { tlas.Record(cb, next, 2, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR); });
+    device.OneShot(
+        [&](VkCommandBuffer cb) { tlas.Record(cb, next, 2, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR); });
     device.Destroy(instances);
     instances = next;
   }

@@ -90,7 +90,8 @@ struct Build {
     }
     info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
     info.flags = flags;
-    info.mode = update_src ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    info.mode =
+        update_src ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
     info.srcAccelerationStructure = update_src;
     info.dstAccelerationStructure = dst;
     info.geometryCount = static_cast<uint32_t>(geometries.size());
@@ -128,7 +129,8 @@ std::vector<std::string> Execute(World& w, const OpBatch& batch, uint32_t enable
 OpBatch Builds(OpCommand command, std::initializer_list<const Build*> builds) {
   OpBatch batch;
   for (const Build* b : builds) {
-    batch.AppendBuilds(Origin(command), 1, &b->info, command == OpCommand::kCmdBuildIndirect ? nullptr : &b->range_pointer);
+    const bool indirect = command == OpCommand::kCmdBuildIndirect;
+    batch.AppendBuilds(Origin(command), 1, &b->info, indirect ? nullptr : &b->range_pointer);
   }
   return batch;
 }
@@ -243,9 +245,9 @@ TEST_CASE("history unit: host copies and property writes are checked when called
   // Valid twins: the compaction of a compactable structure and its property query.
   CHECK_FALSE(CheckHostOps(w.state, reporter, kAll, HostCopyOps(copy), "vkCopyAccelerationStructureKHR"));
   const VkAccelerationStructureKHR structures[] = {w.a};
-  CHECK_FALSE(CheckHostOps(w.state, reporter, kAll,
-                           HostWritePropertiesOps(1, structures, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR),
-                           "vkWriteAccelerationStructuresPropertiesKHR"));
+  const OpBatch query =
+      HostWritePropertiesOps(1, structures, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR);
+  CHECK_FALSE(CheckHostOps(w.state, reporter, kAll, query, "vkWriteAccelerationStructuresPropertiesKHR"));
   CHECK(reporter.ErrorCount() == 1);
   FinishHostOps(w.state, kAll, HostCopyOps(copy), VK_NULL_HANDLE, VK_SUCCESS);
   // The compacted copy updates like its source.
@@ -472,7 +474,9 @@ TEST_CASE("history bench: operations applied per second at submission", "[.histo
     if (sc.update) {
       ResetCommandBufferLog(w.state, cb);
       const size_t count = builds.size();
-      for (size_t i = 0; i < count; ++i) builds.emplace_back(handles[i], std::vector<uint32_t>{4, 4}, kUpdatable, handles[i]);
+      for (size_t i = 0; i < count; ++i) {
+        builds.emplace_back(handles[i], std::vector<uint32_t>{4, 4}, kUpdatable, handles[i]);
+      }
       for (size_t i = count; i < builds.size(); ++i) {
         cmd.infos = &builds[i].info;
         cmd.ranges = &builds[i].range_pointer;
