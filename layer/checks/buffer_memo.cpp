@@ -13,14 +13,13 @@ KnownBuffer FromRecord(const BufferState& record, VkDeviceAddress base, VkDevice
 
 }  // namespace
 
-bool BufferMemo::Holding(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
-                         VkBufferUsageFlags usage, KnownBuffer* out) {
-  const VkDeviceSize wanted = bytes == 0 ? 1 : bytes;
+const KnownBuffer* BufferMemo::HeldSlow(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
+                                        VkBufferUsageFlags usage) {
   for (int k = 0; k < count_; ++k) {
-    const KnownBuffer& e = entries_[k];
-    if ((e.usage & usage) == usage && e.Holds(address, wanted)) {
-      *out = e;
-      return true;
+    if (Serves(entries_[k], address, bytes, usage)) {
+      before_ = last_;
+      last_ = k;
+      return &entries_[k];
     }
   }
   // The candidate the address map accepts is the one whose record the predicate saw: keep that record.
@@ -31,10 +30,10 @@ bool BufferMemo::Holding(const DeviceState& state, VkDeviceAddress address, VkDe
     accepted = std::move(*record);
     return true;
   });
-  if (!hit || !accepted) return false;
-  *out = FromRecord(*accepted, hit->base, hit->size);
-  Remember(*out);
-  return true;
+  if (!hit || !accepted) return nullptr;
+  before_ = last_;
+  last_ = Remember(FromRecord(*accepted, hit->base, hit->size));
+  return &entries_[last_];
 }
 
 bool BufferMemo::Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* out) {
@@ -57,13 +56,15 @@ bool BufferMemo::Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* ou
   return true;
 }
 
-void BufferMemo::Remember(const KnownBuffer& entry) {
+int BufferMemo::Remember(const KnownBuffer& entry) {
   if (count_ < kEntries) {
-    entries_[count_++] = entry;
-    return;
+    entries_[count_] = entry;
+    return count_++;
   }
-  entries_[next_] = entry;
+  const int slot = next_;
+  entries_[slot] = entry;
   next_ = (next_ + 1) % kEntries;
+  return slot;
 }
 
 }  // namespace asval

@@ -1,13 +1,16 @@
 #pragma once
-// The buffers one build command has already looked up. A recorded build reads many ranges of the same few
+// The buffers recent build commands have looked up. A recorded build reads many ranges of the same few
 // buffers: one vertex buffer for many geometries, one scratch buffer sliced per info, one storage buffer
-// holding many structures. The memo keeps the last few buffers found (their address range, usage and memory
-// binding), so each is looked up in the shared maps (locks, hashing) once per call rather than once per
-// range. It lives on the stack of one call: nothing in it outlives the command, so it cannot go stale.
+// holding many structures; a frame records the same buffers call after call. The memo keeps the last few
+// buffers found (their address range, usage and memory binding), so each is looked up in the shared maps
+// (locks, hashing) once rather than once per range. One memo per thread, kept from call to call: Sync, at
+// the start of each call, empties it unless the device's buffer map and address map are the very ones it
+// was filled from and have not changed since (their change stamps), so it never serves a stale record.
 #include <vulkan/vulkan.h>
 
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include "device_state.h"
 
@@ -32,17 +35,60 @@ class BufferMemo {
   // A bound buffer whose address range holds all of [address, address + bytes) (bytes 0: just `address`) and
   // that was created with every bit of `usage`; false when none does.
   bool Holding(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes, VkBufferUsageFlags usage,
-               KnownBuffer* out);
+               KnownBuffer* out) {
+    const KnownBuffer* held = Held(state, address, bytes, usage);
+    if (!held) return false;
+    *out = *held;
+    return true;
+  }
+  // The same without copying the record out: the entry stays valid until the memo's next lookup. The two
+  // entries that answered last are tried first, inline (the geometries of a call mostly read one vertex
+  // buffer; its infos alternate between that and one scratch buffer).
+  const KnownBuffer* Held(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
+                          VkBufferUsageFlags usage) {
+    const KnownBuffer& last = entries_[last_];  // an empty entry (size 0) holds nothing
+    if (Serves(last, address, bytes, usage)) return &last;
+    const KnownBuffer& before = entries_[before_];
+    if (Serves(before, address, bytes, usage)) {
+      std::swap(last_, before_);
+      return &before;
+    }
+    return HeldSlow(state, address, bytes, usage);
+  }
+  // Empties the memo unless it was filled from these very maps, unchanged since. Call before any lookup of a
+  // command.
+  void Sync(const DeviceState& state) {
+    const StampValue buffers = state.buffers.stamp();
+    const StampValue addresses = state.buffer_addresses.stamp();
+    if (buffers == buffers_stamp_ && addresses == addresses_stamp_) return;
+    buffers_stamp_ = buffers;
+    addresses_stamp_ = addresses;
+    count_ = 0;
+    next_ = 0;
+    last_ = 0;
+    before_ = 0;
+    entries_[0] = KnownBuffer{};  // Held tries entries_[last_] and entries_[before_] before looking at count_
+  }
   // The record of `buffer`; false when the layer does not know the buffer.
   bool Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* out);
 
  private:
-  static constexpr int kEntries = 8;
-  void Remember(const KnownBuffer& entry);
+  static constexpr int kEntries = 32;
+  static bool Serves(const KnownBuffer& e, VkDeviceAddress address, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+    return (e.usage & usage) == usage && e.Holds(address, bytes == 0 ? 1 : bytes);
+  }
+  const KnownBuffer* HeldSlow(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
+                              VkBufferUsageFlags usage);
+  // Stores an entry; returns its index.
+  int Remember(const KnownBuffer& entry);
 
   std::array<KnownBuffer, kEntries> entries_{};
   int count_ = 0;
   int next_ = 0;  // round-robin replacement once full
+  int last_ = 0;    // the entry Held returned last
+  int before_ = 0;  // and the one before it
+  StampValue buffers_stamp_;    // the maps the entries come from, as they were (id 0: none yet)
+  StampValue addresses_stamp_;
 };
 
 }  // namespace asval

@@ -1,5 +1,8 @@
 #include "build_addresses.h"
 
+#include <array>
+#include <cstdint>
+
 #include "buffer_lookup.h"
 #include "buffer_memo.h"
 #include "build_report.h"
@@ -18,42 +21,45 @@ constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKH
 
 // Bytes of one vertex of `format` (never more than the real size: a range the layer computes must be a lower
 // bound of what the build reads). Formats outside the table count as their alignment unit, at least 1.
+// The formats with a known size all have core enum values below 110: a table, not a switch, on the hot path.
+constexpr std::size_t kVertexBytesTableSize = 110;
+constexpr std::array<uint8_t, kVertexBytesTableSize> MakeVertexBytesTable() {
+  std::array<uint8_t, kVertexBytesTableSize> t{};
+  t[VK_FORMAT_R32G32B32A32_SFLOAT] = 16;
+  t[VK_FORMAT_R32G32B32_SFLOAT] = 12;
+  t[VK_FORMAT_R32G32_SFLOAT] = 8;
+  t[VK_FORMAT_R16G16B16A16_SFLOAT] = 8;
+  t[VK_FORMAT_R16G16B16A16_SNORM] = 8;
+  t[VK_FORMAT_R16G16B16A16_UNORM] = 8;
+  t[VK_FORMAT_R16G16_SFLOAT] = 4;
+  t[VK_FORMAT_R16G16_SNORM] = 4;
+  t[VK_FORMAT_R16G16_UNORM] = 4;
+  t[VK_FORMAT_R8G8B8A8_SNORM] = 4;
+  t[VK_FORMAT_R8G8B8A8_UNORM] = 4;
+  t[VK_FORMAT_A2B10G10R10_UNORM_PACK32] = 4;
+  t[VK_FORMAT_R8G8_SNORM] = 2;
+  t[VK_FORMAT_R8G8_UNORM] = 2;
+  return t;
+}
+constexpr std::array<uint8_t, kVertexBytesTableSize> kVertexBytes = MakeVertexBytesTable();
+
 VkDeviceSize VertexBytes(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-      return 16;
-    case VK_FORMAT_R32G32B32_SFLOAT:
-      return 12;
-    case VK_FORMAT_R32G32_SFLOAT:
-    case VK_FORMAT_R16G16B16A16_SFLOAT:
-    case VK_FORMAT_R16G16B16A16_SNORM:
-    case VK_FORMAT_R16G16B16A16_UNORM:
-      return 8;
-    case VK_FORMAT_R16G16_SFLOAT:
-    case VK_FORMAT_R16G16_SNORM:
-    case VK_FORMAT_R16G16_UNORM:
-    case VK_FORMAT_R8G8B8A8_SNORM:
-    case VK_FORMAT_R8G8B8A8_UNORM:
-    case VK_FORMAT_A2B10G10R10_UNORM_PACK32:
-      return 4;
-    case VK_FORMAT_R8G8_SNORM:
-    case VK_FORMAT_R8G8_UNORM:
-      return 2;
-    default: {
-      const uint32_t unit = AlignmentOfVertexFormat(format).bytes;
-      return unit ? unit : 1;
-    }
-  }
+  const auto index = static_cast<uint32_t>(format);
+  if (index < kVertexBytesTableSize && kVertexBytes[index] != 0) return kVertexBytes[index];
+  const uint32_t unit = AlignmentOfVertexFormat(format).bytes;
+  return unit ? unit : 1;
 }
 
-// One range a geometry reads, and the rule that makes its start a valid device address.
+// One range a geometry reads, and the rule that makes its start a valid device address. No default member
+// initializers: ReadsOfGeometry assigns every member of each read it returns, and the clean path should not
+// pay for clearing three of them per geometry.
 struct InputRead {
-  const char* data_member = nullptr;  // "triangles", "aabbs", "instances"
-  const char* field = nullptr;        // "vertexData", "indexData", "transformData", "data"
-  const char* valid_vuid = nullptr;   // "pInfos-03804", ...
-  const char* how = nullptr;          // how the size was found, for the message
-  VkDeviceAddress address = 0;
-  VkDeviceSize size = 0;              // bytes read from address on (at least 1)
+  const char* data_member;  // "triangles", "aabbs", "instances"
+  const char* field;        // "vertexData", "indexData", "transformData", "data"
+  const char* valid_vuid;   // "pInfos-03804", ...
+  const char* how;          // how the size was found, for the message
+  VkDeviceAddress address;
+  VkDeviceSize size;        // bytes read from address on (at least 1)
 };
 
 // The ranges geometry g reads. With a range (direct builds): exactly the bytes the specification says the
@@ -170,9 +176,8 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
     }
     InputRead reads[3];
     const int n = ReadsOfGeometry(*g, range, reads);
-    KnownBuffer holder;
     for (int k = 0; k < n; ++k) {
-      if (!memo.Holding(ctx.state, reads[k].address, reads[k].size, kInputUsage, &holder)) {
+      if (!memo.Held(ctx.state, reads[k].address, reads[k].size, kInputUsage)) {
         skip |= ReportRead(ctx, cmd, i, j, reads[k]);
       }
     }
@@ -255,8 +260,7 @@ bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, ui
   if (!cmd.indirect_addresses || !cmd.indirect_strides) return false;
   const VkDeviceSize bytes = SaturatingMul(cmd.infos[i].geometryCount, cmd.indirect_strides[i]);
   if (bytes == 0) return false;  // no range is read
-  KnownBuffer holder;
-  if (memo.Holding(ctx.state, cmd.indirect_addresses[i], bytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, &holder)) {
+  if (memo.Held(ctx.state, cmd.indirect_addresses[i], bytes, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)) {
     return false;
   }
   return ReportIndirectRanges(ctx, cmd, i, bytes);

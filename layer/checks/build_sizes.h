@@ -30,6 +30,20 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
 // they cannot be known: counts not given, or the query would not be valid (see SizeQueryIsValid).
 std::optional<BuildSizes> SizesOfInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i);
 
+// True when pInfos[a] and pInfos[b] certainly have the same signature, without reading it: no extension chain,
+// the same header fields, and the very same geometry and count arrays (the app cannot change them during
+// the call). Then pInfos[b]'s sizes are pInfos[a]'s.
+inline bool SameSignatureArrays(const BuildCommand& cmd, uint32_t a, uint32_t b) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& x = cmd.infos[a];
+  const VkAccelerationStructureBuildGeometryInfoKHR& y = cmd.infos[b];
+  if (x.pNext || y.pNext || x.sType != y.sType || x.type != y.type || x.flags != y.flags ||
+      x.geometryCount != y.geometryCount || x.pGeometries != y.pGeometries || x.ppGeometries != y.ppGeometries) {
+    return false;
+  }
+  if (cmd.is_indirect()) return cmd.max_primitive_counts && cmd.max_primitive_counts[a] == cmd.max_primitive_counts[b];
+  return cmd.ranges && cmd.ranges[a] == cmd.ranges[b];
+}
+
 // pInfos-10126 / pInfos-03652 and pInfos-03801 for pInfos[i], all three commands.
 bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r);
 

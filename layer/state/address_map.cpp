@@ -35,6 +35,7 @@ void AddressHits::push_back(const AddressHit& hit) {
 
 bool DeviceAddressMap::Insert(VkDeviceAddress base, VkDeviceSize size, VkBuffer buffer) {
   std::unique_lock lock(mutex_);
+  stamp_.Bump();  // under the lock: a reader that sees the new count looks the map up after this change
   EraseLocked(buffer);
   const std::optional<VkDeviceAddress> last = LastAddress(base, size);
   if (buffer == VK_NULL_HANDLE || !last) return false;
@@ -71,6 +72,7 @@ bool DeviceAddressMap::Erase(VkDeviceAddress base, VkBuffer buffer) {
 bool DeviceAddressMap::EraseLocked(VkBuffer buffer) {
   const auto found = ranges_.find(buffer);
   if (found == ranges_.end()) return false;
+  stamp_.Bump();
   const Range range = found->second;
   ranges_.erase(found);
 
@@ -157,6 +159,7 @@ void DeviceAddressMap::Clear() {
   std::unique_lock lock(mutex_);
   segments_.clear();
   ranges_.clear();
+  stamp_.Bump();
 }
 
 std::size_t DeviceAddressMap::SegmentCount() const {

@@ -35,6 +35,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "change_stamp.h"
+
 #include "concurrent_map.h"
 
 namespace asval {
@@ -113,6 +115,8 @@ class DeviceAddressMap {
   std::size_t size() const;  // buffers in the map
   bool empty() const { return size() == 0; }
   void Clear();
+  // Changes so far (every Insert, Erase and Clear that changed something): equal stamps, no change between.
+  StampValue stamp() const { return stamp_.Read(); }
 
   // Number of elementary segments; at most 2 * size(). For tests and diagnostics.
   std::size_t SegmentCount() const;
@@ -147,6 +151,7 @@ class DeviceAddressMap {
   mutable std::shared_mutex mutex_;
   SegmentMap segments_;
   std::unordered_map<VkBuffer, Range, HandleHash<VkBuffer>> ranges_;
+  ChangeStamp stamp_;
 };
 
 }  // namespace asval

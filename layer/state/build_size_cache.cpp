@@ -17,8 +17,14 @@ void EmitSignature(const BuildSignature& s, Sink& sink) {
   const uint64_t chained = info.pNext ? uint64_t{1} << 63 : 0;
   sink(chained | (uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(info.type));
   sink((uint64_t{info.flags} << 32) | info.geometryCount);
-  for (uint32_t j = 0; j < info.geometryCount; ++j) {
-    const VkAccelerationStructureGeometryKHR* g = s.Geometry(j);
+  // The geometry array and the counts are walked by pointer: Geometry(j) and Count(j) would re-test which
+  // array the info uses and multiply the stride for every word.
+  const VkAccelerationStructureGeometryKHR* geometries = info.pGeometries;
+  const VkAccelerationStructureGeometryKHR* const* geometry_pointers = geometries ? nullptr : info.ppGeometries;
+  const char* count = reinterpret_cast<const char*>(s.counts);
+  for (uint32_t j = 0; j < info.geometryCount; ++j, count += s.count_stride) {
+    const VkAccelerationStructureGeometryKHR* g =
+        geometries ? &geometries[j] : geometry_pointers ? geometry_pointers[j] : nullptr;
     if (!g) {
       sink(~uint64_t{0});
       continue;
@@ -43,30 +49,32 @@ void EmitSignature(const BuildSignature& s, Sink& sink) {
       default:
         break;  // not cacheable (BuildSignature::Cacheable), never stored
     }
-    sink(s.Count(j));
+    sink(uint64_t{*reinterpret_cast<const uint32_t*>(count)});
   }
 }
 
+// An upper bound of the words EmitSignature hands out: two for the info, at most five per geometry (header,
+// three of triangle data, count).
+std::size_t MaxSignatureWords(const BuildSignature& s) { return 2 + std::size_t{5} * s.info->geometryCount; }
+
+// One xor and one multiply per word: the word-by-word compare, not the hash, rules out collisions, and Finish
+// spreads the high bits the multiply leaves unmixed.
 struct HashSink {
   uint64_t h = 0x243f6a8885a308d3ull;
-  void operator()(uint64_t w) {
-    h ^= w;
-    h *= 0x9e3779b97f4a7c15ull;
-    h ^= h >> 29;
-  }
+  void operator()(uint64_t w) { h = (h ^ w) * 0x9e3779b97f4a7c15ull; }
 };
 
-// Hashes the words and keeps the first kLocalWords of them for a word-by-word compare.
+// Hashes the words and keeps them all for a word-by-word compare; used only when MaxSignatureWords fits, so
+// it needs no bound check per word.
 struct BufferedSink {
-  uint64_t words[BuildSizeCache::kLocalWords];
+  static constexpr std::size_t kCapacity = 512;  // 4 KiB of stack: infos of up to 102 geometries
+  uint64_t words[kCapacity];
   std::size_t count = 0;
   HashSink hash;
   void operator()(uint64_t w) {
-    if (count < BuildSizeCache::kLocalWords) words[count] = w;
-    ++count;
+    words[count++] = w;
     hash(w);
   }
-  bool buffered() const { return count <= BuildSizeCache::kLocalWords; }
 };
 
 struct CompareSink {
@@ -157,10 +165,13 @@ void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::
 }
 
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) const {
+  if (MaxSignatureWords(signature) > BufferedSink::kCapacity) return FindLong(signature, out);
+  // The signature is read from the app's structures once: hashed and kept on the stack for the compares.
   BufferedSink sink;
   EmitSignature(signature, sink);
   const uint64_t hash = Finish(sink.hash.h);
-  if (sink.buffered()) {
+  const bool local = sink.count <= kLocalWords;
+  if (local) {
     const LocalEntry& slot = LocalSlot(hash);
     if (slot.cache_id == id_ && slot.hash == hash && slot.count == sink.count &&
         std::memcmp(slot.words, sink.words, sink.count * sizeof(uint64_t)) == 0) {
@@ -174,18 +185,26 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) cons
     const auto it = shard.map.find(hash);
     if (it == shard.map.end()) return false;
     const std::vector<uint64_t>& stored = it->second.words;
-    if (sink.buffered()) {
-      if (stored.size() != sink.count || std::memcmp(stored.data(), sink.words, sink.count * sizeof(uint64_t)) != 0) {
-        return false;
-      }
-    } else {
-      CompareSink compare{stored};
-      EmitSignature(signature, compare);
-      if (!compare.equal || compare.next != stored.size()) return false;
+    if (stored.size() != sink.count || std::memcmp(stored.data(), sink.words, sink.count * sizeof(uint64_t)) != 0) {
+      return false;
     }
     *out = it->second.sizes;
   }
-  if (sink.buffered()) RememberLocally(hash, sink.words, sink.count, *out);
+  if (local) RememberLocally(hash, sink.words, sink.count, *out);
+  return true;
+}
+
+bool BuildSizeCache::FindLong(const BuildSignature& signature, BuildSizes* out) const {
+  // Too long for the stack: hashed in one pass, compared against the stored copy in a second.
+  const uint64_t hash = HashOf(signature);
+  const Shard& shard = ShardFor(hash);
+  std::shared_lock lock(shard.mutex);
+  const auto it = shard.map.find(hash);
+  if (it == shard.map.end()) return false;
+  CompareSink compare{it->second.words};
+  EmitSignature(signature, compare);
+  if (!compare.equal || compare.next != it->second.words.size()) return false;
+  *out = it->second.sizes;
   return true;
 }
 

@@ -115,14 +115,18 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
     op.geometry_count = info.geometryCount;
     op.first_geometry = static_cast<uint32_t>(geometries_.size());
     const bool has_geometries = info.pGeometries || info.ppGeometries;
-    for (uint32_t j = 0; has_geometries && j < info.geometryCount; ++j) {
-      const VkAccelerationStructureGeometryKHR& g = info.pGeometries ? info.pGeometries[j] : *info.ppGeometries[j];
-      GeometryRecord record = MakeGeometryRecord(g);
-      if (ranges && ranges[i]) {
-        record.primitive_count = ranges[i][j].primitiveCount;
-        record.primitive_count_known = true;
+    if (has_geometries && info.geometryCount != 0) {
+      // Whether the info has ranges is decided once, not per geometry. (No reserve: one of the exact size per
+      // info would defeat the vector's geometric growth and copy the whole batch on every call.)
+      const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges ? ranges[i] : nullptr;
+      for (uint32_t j = 0; j < info.geometryCount; ++j) {
+        GeometryRecord record = MakeGeometryRecord(info.pGeometries ? info.pGeometries[j] : *info.ppGeometries[j]);
+        if (info_ranges) {
+          record.primitive_count = info_ranges[j].primitiveCount;
+          record.primitive_count_known = true;
+        }
+        geometries_.push_back(record);
       }
-      geometries_.push_back(record);
     }
     if (!has_geometries) op.geometry_count = 0;  // nothing to compare (invalid, and another rule's business)
     ops_.push_back(op);

@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "change_stamp.h"
+
 namespace asval {
 
 // 64-bit finalizer of MurmurHash3 (fmix64): every input bit flips about half of the output bits. Vulkan
@@ -62,7 +64,9 @@ class ConcurrentMap {
   bool insert_or_assign(const Key& key, V&& value) {
     Shard& shard = ShardFor(key);
     std::unique_lock lock(shard.mutex);
-    return shard.map.insert_or_assign(key, std::forward<V>(value)).second;
+    const bool inserted = shard.map.insert_or_assign(key, std::forward<V>(value)).second;
+    stamp_.Bump();
+    return inserted;
   }
 
   // Constructs the value only if the key is absent. Returns false (and leaves the old value) if present.
@@ -70,7 +74,9 @@ class ConcurrentMap {
   bool emplace(const Key& key, Args&&... args) {
     Shard& shard = ShardFor(key);
     std::unique_lock lock(shard.mutex);
-    return shard.map.try_emplace(key, std::forward<Args>(args)...).second;
+    const bool inserted = shard.map.try_emplace(key, std::forward<Args>(args)...).second;
+    if (inserted) stamp_.Bump();
+    return inserted;
   }
 
   // A copy of the value: for shared_ptr values the object stays alive after a concurrent erase.
@@ -92,7 +98,9 @@ class ConcurrentMap {
   bool erase(const Key& key) {
     Shard& shard = ShardFor(key);
     std::unique_lock lock(shard.mutex);
-    return shard.map.erase(key) != 0;
+    const bool erased = shard.map.erase(key) != 0;
+    if (erased) stamp_.Bump();
+    return erased;
   }
 
   // Erases and hands back the value in one locked step, so exactly one of several racing callers gets it
@@ -104,6 +112,7 @@ class ConcurrentMap {
     if (it == shard.map.end()) return std::nullopt;
     std::optional<T> value(std::move(it->second));
     shard.map.erase(it);
+    stamp_.Bump();
     return value;
   }
 
@@ -142,8 +151,12 @@ class ConcurrentMap {
     for (Shard& shard : shards_) {
       std::unique_lock lock(shard.mutex);
       shard.map.clear();
+      stamp_.Bump();
     }
   }
+
+  // Changes so far (every insert, replacement and removal counts): equal stamps, no change in between.
+  StampValue stamp() const { return stamp_.Read(); }
 
  private:
   // One cache line (at least) per shard, so that two threads locking neighbouring shards do not bounce
@@ -169,6 +182,7 @@ class ConcurrentMap {
   const Shard& ShardFor(const Key& key) const { return shards_[ShardIndex(key)]; }
 
   std::array<Shard, kShardCount> shards_;
+  ChangeStamp stamp_;
 };
 
 }  // namespace asval
