@@ -3,6 +3,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <emmintrin.h>
 #include <vector>
 
 #include "asval/builder/build_input.h"
@@ -64,6 +65,29 @@ void Put(BuildInput* out, uint32_t id, const float lo[3], const float hi[3]) {
     out->refs.push_back(r);
 }
 
+// Three floats into lanes 0..2 (lane 3 = 0) without reading past them.
+inline __m128 Load3(const uint8_t* p) {
+    double xy;  // memcpy: the data may be unaligned (any stride)
+    float z;
+    std::memcpy(&xy, p, 8);
+    std::memcpy(&z, p + 8, 4);
+    return _mm_movelh_ps(_mm_castpd_ps(_mm_set_sd(xy)), _mm_set_ss(z));
+}
+
+// Put() for boxes already in SIMD registers (the float fast path).
+inline void PutSimd(BuildInput* out, uint32_t id, __m128 lo, __m128 hi) {
+    alignas(16) PrimRef r;
+    _mm_store_ps(r.lo, lo);
+    _mm_store_ps(r.hi, hi);
+    r.id = id;
+    r.aux = 0;
+    const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)), big = _mm_set1_ps(FLT_MAX);
+    const int infinite = _mm_movemask_ps(_mm_or_ps(_mm_cmpnle_ps(_mm_and_ps(lo, absMask), big),
+                                                   _mm_cmpnle_ps(_mm_and_ps(hi, absMask), big))) & 7;
+    out->infiniteBoxes += infinite != 0;
+    out->refs.push_back(r);
+}
+
 // Sorts a primitive's classification into "kept" or one of the exclusion counters.
 bool Keep(uint8_t s, bool allowUpdate, BuildInput* out) {
     if (s & kStateUnreadable) { ++out->excludedUnreadable; return false; }
@@ -97,7 +121,7 @@ void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_
         // Fast path (the common case): float vertices are exact, the box is their min / max.
         for (uint32_t t = 0; t < n; ++t) {
             if (!Keep(states[t], allowUpdate, out)) continue;
-            float v[3][3];
+            __m128 v[3];
             for (int k = 0; k < 3; ++k) {
                 uint64_t off;
                 if (indexBytes == 0) {
@@ -107,14 +131,12 @@ void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_
                     const uint64_t idx = indexBytes == 1 ? ip[0] : indexBytes == 2 ? detail::LoadU16(ip) : detail::LoadU32(ip);
                     off = (idx + view.range.firstVertex) * view.vertexStride;
                 }
-                std::memcpy(v[k], vb + off, 12);
+                v[k] = Load3(vb + off);
             }
-            float lo[3], hi[3];
-            for (int c = 0; c < 3; ++c) {
-                lo[c] = std::min(v[0][c], std::min(v[1][c], v[2][c]));
-                hi[c] = std::max(v[0][c], std::max(v[1][c], v[2][c]));
-            }
-            Put(out, idBase + t, lo, hi);
+            // min(v0, min(v1, v2)) with std::min's operand order (it decides which zero a +-0 tie keeps).
+            const __m128 lo = _mm_min_ps(_mm_min_ps(v[2], v[1]), v[0]);
+            const __m128 hi = _mm_max_ps(_mm_max_ps(v[2], v[1]), v[0]);
+            PutSimd(out, idBase + t, lo, hi);
         }
         return;
     }

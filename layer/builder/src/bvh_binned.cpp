@@ -1,7 +1,9 @@
 // Binned SAH builder (default mode). Top-down; each node bins reference centroids on all three axes,
 // sweeps the bins for the cheapest SAH split and partitions in place. Subtrees above kSpawnRefs become
-// tasks that any thread may run; each task writes its own node array and the arrays are stitched in a
-// fixed order, so the tree is identical for every thread count.
+// tasks that any thread may run; each task records its subtree as a pre-order byte code (1 byte per node,
+// no boxes), and the codes are expanded into the output in a fixed order, so the tree is identical for
+// every thread count. Boxes are recomputed from the references during that expansion: the build never
+// holds two copies of the tree (peak = references + tree + ids, not references + 2 x tree).
 #include <emmintrin.h>
 
 #include <algorithm>
@@ -12,7 +14,7 @@
 #include <mutex>
 #include <thread>
 
-#include "bvh_internal.h"
+#include "bvh_code.h"
 
 namespace asval::builder::detail {
 namespace {
@@ -20,20 +22,6 @@ namespace {
 constexpr uint32_t kSpawnRefs = 4096;
 constexpr uint32_t kMaxBins = 64;
 constexpr uint32_t kSweepMax = 12;  // nodes this small get an exact SAH sweep instead of bins
-
-struct Range {
-    uint32_t begin, end;
-    __m128 lo, hi;    // box of the references
-    __m128 clo, chi;  // box of their centroids
-    uint32_t depth;   // 1 for the root
-};
-
-struct Task {
-    Range range;
-    std::vector<BvhNode> nodes;  // nodes[0] is this task's root
-    // Subtrees handed to other tasks: (slot in `nodes` that will hold that task's root, the task).
-    std::vector<std::pair<uint32_t, std::unique_ptr<Task>>> children;
-};
 
 class Queue {
 public:
@@ -79,9 +67,8 @@ public:
           maxLeaf_(std::clamp<uint32_t>(o.maxLeafSize, 1, 8)), queue_(q) {}
 
     void RunTask(Task* task) {
-        task->nodes.emplace_back();
-        Build(task, 0, task->range);
-        task->nodes.shrink_to_fit();  // finished tasks keep no growth slack: peak memory stays near the tree
+        Build(task, task->range);
+        task->code.shrink_to_fit();
     }
 
 private:
@@ -90,12 +77,7 @@ private:
     uint32_t maxLeaf_;
     Queue* queue_;
 
-    void MakeLeaf(Task* task, uint32_t slot, const Range& r) {
-        BvhNode& n = task->nodes[slot];
-        StoreNodeBox(n, r.lo, r.hi);
-        n.leftOrFirst = r.begin;
-        n.count = r.end - r.begin;
-    }
+    static void MakeLeaf(Task* task, const Range& r) { task->code.push_back(uint8_t(r.end - r.begin)); }
 
     // Running box + centroid box of one side of a split.
     struct Side {
@@ -267,11 +249,11 @@ private:
         return true;
     }
 
-    void Build(Task* task, uint32_t slot, Range r) {
+    void Build(Task* task, Range r) {
         const uint32_t count = r.end - r.begin;
-        if (count == 1) { MakeLeaf(task, slot, r); return; }
+        if (count == 1) { MakeLeaf(task, r); return; }
         const bool forceMedian = r.depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth;
-        if (forceMedian && count <= maxLeaf_) { MakeLeaf(task, slot, r); return; }
+        if (forceMedian && count <= maxLeaf_) { MakeLeaf(task, r); return; }
 
         Range left, right;
         double cost = INFINITY;
@@ -279,7 +261,7 @@ private:
         if (!forceMedian) found = count <= kSweepMax ? SweepSmall(r, &cost, &left, &right) : Binned(r, &cost, &left, &right);
         if (count <= maxLeaf_) {
             const double nodeArea = HalfArea(r.lo, r.hi);
-            if (!found || !(nodeArea + cost < nodeArea * count)) { MakeLeaf(task, slot, r); return; }
+            if (!found || !(nodeArea + cost < nodeArea * count)) { MakeLeaf(task, r); return; }
         }
         if (!found) {
             // No usable SAH split (identical centroids, depth budget): halve; by centroid when they differ.
@@ -299,47 +281,22 @@ private:
             right = rr.ToRange(mid, r.end, r.depth + 1);
         }
 
-        const uint32_t childSlot = uint32_t(task->nodes.size());
-        task->nodes.emplace_back();
-        task->nodes.emplace_back();
-        BvhNode& n = task->nodes[slot];
-        StoreNodeBox(n, r.lo, r.hi);
-        n.leftOrFirst = childSlot;
-        n.count = 0;
         if (right.end - right.begin >= kSpawnRefs) {
+            task->code.push_back(kCodeInnerSpawned);
             auto child = std::make_unique<Task>();
             child->range = right;
             Task* raw = child.get();
-            task->children.emplace_back(childSlot + 1, std::move(child));
+            task->children.push_back(std::move(child));
             queue_->Push(raw);
-            Build(task, childSlot, left);
+            Build(task, left);
         } else {
-            Build(task, childSlot, left);
-            Build(task, childSlot + 1, right);
+            task->code.push_back(kCodeInner);
+            Build(task, left);
+            Build(task, right);
         }
     }
 };
 
-// Appends `task`'s nodes to `out`, its root going to out[rootSlot]; then its child tasks, in order.
-void Stitch(Task& task, uint32_t rootSlot, std::vector<BvhNode>& out) {
-    const uint32_t base = uint32_t(out.size());
-    auto remap = [base](uint32_t local) { return base + local - 1; };  // local 0 is the root
-    auto fix = [&](BvhNode n) {
-        if (n.count == 0) n.leftOrFirst = remap(n.leftOrFirst);
-        return n;
-    };
-    out.resize(out.size() + task.nodes.size() - 1);
-    for (size_t i = 1; i < task.nodes.size(); ++i) out[remap(uint32_t(i))] = fix(task.nodes[i]);
-    out[rootSlot] = fix(task.nodes[0]);
-    std::vector<BvhNode>().swap(task.nodes);
-    for (auto& [slot, child] : task.children) Stitch(*child, remap(slot), out);
-}
-
-size_t CountNodes(const Task& t) {
-    size_t n = t.nodes.size() - 1;
-    for (const auto& c : t.children) n += CountNodes(*c.second);
-    return n;
-}
 
 }  // namespace
 
@@ -371,13 +328,12 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
     queue.Work(run);
     for (auto& w : workers) w.join();
 
-    // The references are dead once their ids are out: free them before the node arrays are stitched.
+    // Expand the codes (boxes come from the references), then take the ids and free the references.
+    bvh.nodes.resize(CountNodes(root));
+    ExpandCodes(refs.data(), root, bvh.nodes.data(), &bvh.stats);
     bvh.primIds.resize(refs.size());
     for (size_t i = 0; i < refs.size(); ++i) bvh.primIds[i] = refs[i].id;
     std::vector<PrimRef>().swap(refs);
-    bvh.nodes.reserve(CountNodes(root) + 1);
-    bvh.nodes.resize(1);
-    Stitch(root, 0, bvh.nodes);
     return bvh;
 }
 

@@ -54,6 +54,5 @@ constexpr uint32_t kMaxDepth = 64;  // nodes on the longest root-to-leaf path
 
 Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options);
 Bvh BuildLbvh(std::vector<PrimRef>& refs, const BuildOptions& options);
-void FillStats(Bvh& bvh);
 
 }  // namespace asval::builder::detail

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "bvh_internal.h"
+#include "bvh_code.h"
 
 namespace asval::builder::detail {
 namespace {
@@ -28,75 +28,69 @@ struct Keyed {
 
 class LbvhBuilder {
 public:
-    LbvhBuilder(const std::vector<PrimRef>& refs, const std::vector<Keyed>& sorted, uint32_t maxLeaf, Bvh* out)
-        : refs_(refs), sorted_(sorted), maxLeaf_(maxLeaf), out_(out) {}
+    LbvhBuilder(const PrimRef* refs, const uint64_t* codes, uint32_t maxLeaf, std::vector<uint8_t>* out)
+        : refs_(refs), codes_(codes), maxLeaf_(maxLeaf), out_(out) {}
 
-    // Builds [b, e) into out_->nodes[slot]; returns the subtree's SAH cost (unnormalised).
-    double Build(uint32_t slot, uint32_t b, uint32_t e, uint32_t depth, int bit) {
+    // Records [b, e) (references in Morton order) as pre-order codes; returns the subtree's SAH cost
+    // (unnormalised) and its box. A collapsed subtree's codes are cut back to one leaf code.
+    double Build(uint32_t b, uint32_t e, uint32_t depth, int bit, __m128* lo, __m128* hi) {
         const uint32_t count = e - b;
-        if (count == 1) return Leaf(slot, b, e);
+        if (count == 1) return Leaf(b, e, lo, hi);
         uint32_t mid;
-        if (depth + HalvingLevels(count, 1) >= kMaxDepth) {  // this recursion goes down to single references
+        // This recursion goes down to single references. HalvingLevels(count, 1) <= 32 (count < 2^32), so
+        // the loop it runs is skipped above the depth where the budget could bind.
+        if (depth + 32 >= kMaxDepth && depth + HalvingLevels(count, 1) >= kMaxDepth) {
             mid = b + count / 2;
         } else {
             // Highest bit (at or below `bit`) where the first and last codes differ.
-            const uint64_t diff = sorted_[b].code ^ sorted_[e - 1].code;
+            const uint64_t diff = codes_[b] ^ codes_[e - 1];
             if (diff == 0) {
                 mid = b + count / 2;
             } else {
                 bit = 63 - __builtin_clzll(diff);
                 const uint64_t mask = uint64_t(1) << bit;
-                uint32_t lo = b, hi = e - 1;  // first index with the bit set is in (lo, hi]
-                while (hi - lo > 1) {
-                    const uint32_t m = lo + (hi - lo) / 2;
-                    if (sorted_[m].code & mask) hi = m; else lo = m;
+                uint32_t l = b, h = e - 1;  // first index with the bit set is in (l, h]
+                while (h - l > 1) {
+                    const uint32_t m = l + (h - l) / 2;
+                    if (codes_[m] & mask) h = m; else l = m;
                 }
-                mid = hi;
+                mid = h;
                 bit -= 1;
             }
         }
-        const uint32_t childSlot = uint32_t(out_->nodes.size());
-        out_->nodes.emplace_back();
-        out_->nodes.emplace_back();
-        const double cl = Build(childSlot, b, mid, depth + 1, bit);
-        const double cr = Build(childSlot + 1, mid, e, depth + 1, bit);
-        const BvhNode& l = out_->nodes[childSlot];
-        const BvhNode& r = out_->nodes[childSlot + 1];
-        const __m128 lo = _mm_min_ps(_mm_loadu_ps(l.lo), _mm_loadu_ps(r.lo));
-        const __m128 hi = _mm_min_ps(_mm_set1_ps(INFINITY), _mm_max_ps(_mm_loadu_ps(l.hi), _mm_loadu_ps(r.hi)));
-        const double area = HalfArea(lo, hi);
-        BvhNode& n = out_->nodes[slot];
-        StoreNodeBox(n, lo, hi);
+        const size_t pos = out_->size();
+        out_->push_back(kCodeInner);
+        __m128 llo, lhi, rlo, rhi;
+        const double cl = Build(b, mid, depth + 1, bit, &llo, &lhi);
+        const double cr = Build(mid, e, depth + 1, bit, &rlo, &rhi);
+        *lo = _mm_min_ps(llo, rlo);
+        *hi = _mm_min_ps(_mm_set1_ps(INFINITY), _mm_max_ps(lhi, rhi));
+        const double area = HalfArea(*lo, *hi);
         const double inner = area + cl + cr;
         if (count <= maxLeaf_ && area * count <= inner) {
-            out_->nodes.resize(childSlot);  // every descendant was appended after childSlot
-            n.leftOrFirst = b;
-            n.count = count;
+            out_->resize(pos + 1);  // every descendant was recorded after pos
+            (*out_)[pos] = uint8_t(count);
             return area * count;
         }
-        n.leftOrFirst = childSlot;
-        n.count = 0;
         return inner;
     }
 
 private:
-    double Leaf(uint32_t slot, uint32_t b, uint32_t e) {
-        __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+    double Leaf(uint32_t b, uint32_t e, __m128* lo, __m128* hi) {
+        __m128 l = _mm_set1_ps(INFINITY), h = _mm_set1_ps(-INFINITY);
         for (uint32_t i = b; i < e; ++i) {
-            lo = _mm_min_ps(lo, LoadLo(refs_[sorted_[i].ref]));
-            hi = _mm_max_ps(hi, LoadHi(refs_[sorted_[i].ref]));
+            l = _mm_min_ps(l, LoadLo(refs_[i]));
+            h = _mm_max_ps(h, LoadHi(refs_[i]));
         }
-        BvhNode& n = out_->nodes[slot];
-        StoreNodeBox(n, lo, hi);
-        n.leftOrFirst = b;
-        n.count = e - b;
-        return HalfArea(lo, hi) * (e - b);
+        out_->push_back(uint8_t(e - b));
+        *lo = l; *hi = h;
+        return HalfArea(l, h) * (e - b);
     }
 
-    const std::vector<PrimRef>& refs_;
-    const std::vector<Keyed>& sorted_;
+    const PrimRef* refs_;
+    const uint64_t* codes_;
     uint32_t maxLeaf_;
-    Bvh* out_;
+    std::vector<uint8_t>* out_;
 };
 
 }  // namespace
@@ -123,48 +117,85 @@ Bvh BuildLbvh(std::vector<PrimRef>& refs, const BuildOptions& options) {
         scale[a] = extent > 0 ? cells / extent : 0.0;
     }
 
-    std::vector<Keyed> keys(n), tmp(n);
-    for (uint32_t i = 0; i < n; ++i) {
+    auto mortonCode = [&](const PrimRef& r) {
         alignas(16) float c[4];
-        _mm_store_ps(c, Centroid(refs[i]));
+        _mm_store_ps(c, Centroid(r));
         uint64_t code = 0;
         for (int a = 0; a < 3; ++a) {
             double q = (double(c[a]) - double(lo[a])) * scale[a];
             q = q >= 0 ? (q > cells ? cells : q) : 0;  // NaN (from an infinite box) -> 0
             code |= Spread3(uint64_t(q)) << (2 - a);
         }
-        keys[i] = {code, i, 0};
-    }
-    // LSD radix sort, 11-bit digits over the 3 * bitsPerAxis code bits. Stable: ties keep input order.
+        return code;
+    };
+    // LSD radix sort over the 3 * bitsPerAxis code bits. Stable: ties keep input order, so both paths give
+    // the same permutation.
     const uint32_t codeBits = 3 * bitsPerAxis;
-    for (uint32_t shift = 0; shift < codeBits; shift += 11) {
-        uint32_t hist[2048] = {};
-        for (const Keyed& k : keys) ++hist[(k.code >> shift) & 2047];
-        uint32_t sum = 0;
-        for (uint32_t& h : hist) { const uint32_t c = h; h = sum; sum += c; }
-        for (const Keyed& k : keys) tmp[hist[(k.code >> shift) & 2047]++] = k;
-        keys.swap(tmp);
+    std::vector<uint64_t> codes;  // the top-down pass needs only the codes, in sorted reference order
+    if (codeBits <= 32) {
+        // Common case (default 30 bits): sort 8-byte keys `code << 32 | index` on the code bits, with the
+        // histograms of every digit counted in one pass.
+        // Three digits of ceil(bits / 3) <= 11 bits (10 by default: fewer scatter streams than 11).
+        constexpr uint32_t kDigits = 3;
+        const uint32_t digitBits = (codeBits + kDigits - 1) / kDigits, buckets = 1u << digitBits, mask = buckets - 1;
+        std::vector<uint64_t> keys(n), tmp(n);
+        std::vector<uint32_t> hist(kDigits * buckets, 0);
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint64_t code = mortonCode(refs[i]);
+            keys[i] = code << 32 | i;
+            for (uint32_t d = 0; d < kDigits; ++d) ++hist[d * buckets + ((code >> (digitBits * d)) & mask)];
+        }
+        for (uint32_t d = 0; d < kDigits && digitBits * d < codeBits; ++d) {
+            uint32_t* h = &hist[d * buckets];
+            uint32_t sum = 0;
+            for (uint32_t k = 0; k < buckets; ++k) { const uint32_t c = h[k]; h[k] = sum; sum += c; }
+            const unsigned shift = 32 + digitBits * d;
+            for (const uint64_t k : keys) tmp[h[(k >> shift) & mask]++] = k;
+            keys.swap(tmp);
+        }
+        std::vector<uint64_t>().swap(tmp);
+        // Gather the references into Morton order: the top-down pass then reads them sequentially.
+        {
+            std::vector<PrimRef> sortedRefs(n);
+            for (uint32_t i = 0; i < n; ++i) sortedRefs[i] = refs[uint32_t(keys[i])];
+            refs.swap(sortedRefs);
+        }
+        for (uint64_t& k : keys) k >>= 32;
+        codes.swap(keys);
+    } else {
+        // More than 32 code bits: 16-byte keys, 11-bit digits.
+        std::vector<Keyed> keys(n), tmp(n);
+        for (uint32_t i = 0; i < n; ++i) keys[i] = {mortonCode(refs[i]), i, 0};
+        for (uint32_t shift = 0; shift < codeBits; shift += 11) {
+            uint32_t hist[2048] = {};
+            for (const Keyed& k : keys) ++hist[(k.code >> shift) & 2047];
+            uint32_t sum = 0;
+            for (uint32_t& h : hist) { const uint32_t c = h; h = sum; sum += c; }
+            for (const Keyed& k : keys) tmp[hist[(k.code >> shift) & 2047]++] = k;
+            keys.swap(tmp);
+        }
+        std::vector<Keyed>().swap(tmp);
+        {
+            std::vector<PrimRef> sortedRefs(n);
+            for (uint32_t i = 0; i < n; ++i) sortedRefs[i] = refs[keys[i].ref];
+            refs.swap(sortedRefs);
+        }
+        codes.resize(n);
+        for (uint32_t i = 0; i < n; ++i) codes[i] = keys[i].code;
     }
-    std::vector<Keyed>().swap(tmp);
-
-    // Gather the references into Morton order: the top-down pass then reads them sequentially.
-    {
-        std::vector<PrimRef> sortedRefs(n);
-        for (uint32_t i = 0; i < n; ++i) sortedRefs[i] = refs[keys[i].ref];
-        refs.swap(sortedRefs);
-    }
-    for (uint32_t i = 0; i < n; ++i) keys[i].ref = i;
-    // A binary tree over n references has at most 2n - 1 nodes: reserving that avoids regrowth copies
-    // (the dominant term of the peak); the unused tail is returned below only when it is large.
-    bvh.nodes.reserve(size_t(2) * n - 1);
-    bvh.nodes.emplace_back();
-    LbvhBuilder builder(refs, keys, std::clamp<uint32_t>(options.maxLeafSize, 1, 8), &bvh);
-    builder.Build(0, 0, n, 1, 63);
-    std::vector<Keyed>().swap(keys);
+    Task tree;
+    tree.range.begin = 0;
+    tree.range.end = n;
+    tree.range.depth = 1;
+    tree.code.reserve(size_t(2) * n - 1);  // a binary tree over n references has at most 2n - 1 nodes
+    LbvhBuilder builder(refs.data(), codes.data(), std::clamp<uint32_t>(options.maxLeafSize, 1, 8), &tree.code);
+    builder.Build(0, n, 1, 63, &tree.range.lo, &tree.range.hi);
+    std::vector<uint64_t>().swap(codes);
+    bvh.nodes.resize(CountNodes(tree));
+    ExpandCodes(refs.data(), tree, bvh.nodes.data(), &bvh.stats);
     bvh.primIds.resize(n);
     for (uint32_t i = 0; i < n; ++i) bvh.primIds[i] = refs[i].id;
     std::vector<PrimRef>().swap(refs);
-    if (bvh.nodes.size() < bvh.nodes.capacity() / 2) bvh.nodes.shrink_to_fit();
     return bvh;
 }
 

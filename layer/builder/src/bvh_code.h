@@ -1,0 +1,45 @@
+// Private: the compact form both BVH builders record a tree in while building, and its expansion.
+// A subtree is a pre-order byte code, one byte per node and no boxes (a 32-byte node per node would be
+// the largest term of the build's peak); the boxes are recomputed from the references when the code is
+// expanded into the output, once, after the build.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "bvh_internal.h"
+
+namespace asval::builder::detail {
+
+struct Range {
+    uint32_t begin, end;
+    __m128 lo, hi;    // box of the references
+    __m128 clo, chi;  // box of their centroids
+    uint32_t depth;   // 1 for the root
+};
+
+// Pre-order node codes. A leaf's first reference is implicit: leaves tile the task's range in order.
+constexpr uint8_t kCodeInner = 0;         // both children follow in this task's code
+constexpr uint8_t kCodeInnerSpawned = 0xFF;  // the left child follows; the right one is the next child task
+// 1..8: a leaf of that many references
+
+// One subtree recorded by one builder task (binned SAH: a subtree spawned for any thread; LBVH: the
+// whole tree).
+struct Task {
+    Range range;
+    std::vector<uint8_t> code;  // code[0] is this task's root
+    std::vector<std::unique_ptr<Task>> children;  // spawned right subtrees, in pre-order
+    uint32_t rootSlot = 0;  // output slot of code[0]; set while the parent is expanded
+};
+
+// Nodes the tasks recorded, all of them.
+size_t CountNodes(const Task& root);
+
+// Writes the tree into out[0, CountNodes(root)): the root at out[0], a task's other nodes contiguous (inner
+// nodes' child pairs in the order they were recorded), then its child tasks, each in full, in order; a
+// child task's root sits in the slot its parent reserved. Leaves tile the references in pre-order (a
+// task's leaves start at range.begin; its root is at depth range.depth). Frees the codes as it goes.
+// Counts leaves, the largest leaf and the depth into `stats` (which starts zeroed).
+void ExpandCodes(const PrimRef* refs, Task& root, BvhNode* out, BuildStats* stats);
+
+}  // namespace asval::builder::detail
