@@ -77,8 +77,10 @@ class Device {
   PFN_vkGetAccelerationStructureDeviceAddressKHR GetAccelerationStructureDeviceAddressKHR = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT SetDebugUtilsObjectNameEXT = nullptr;
 
- private:
+ // The first memory type in type_bits with all of flags; throws if none.
   uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+
+ private:
 
   VkInstance instance_ = VK_NULL_HANDLE;
   VkPhysicalDevice gpu_ = VK_NULL_HANDLE;

@@ -342,10 +342,11 @@ QueryPool::~QueryPool() { vkDestroyQueryPool(device_.handle(), pool_, nullptr); 
 
 void QueryPool::Reset(VkCommandBuffer cb) { vkCmdResetQueryPool(cb, pool_, 0, count_); }
 
-std::vector<uint64_t> QueryPool::Results() {
-  std::vector<uint64_t> results(count_);
+std::vector<uint64_t> QueryPool::Results(uint32_t first, uint32_t count) {
+  if (count == ~0u) count = count_ - first;
+  std::vector<uint64_t> results(count);
   const VkQueryResultFlags flags = VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT;
-  vkkit::Check(vkGetQueryPoolResults(device_.handle(), pool_, 0, count_, results.size() * sizeof(uint64_t),
+  vkkit::Check(vkGetQueryPoolResults(device_.handle(), pool_, first, count, results.size() * sizeof(uint64_t),
                                      results.data(), sizeof(uint64_t), flags),
                "vkGetQueryPoolResults");
   return results;

@@ -30,17 +30,10 @@ SharedMemory::SharedMemory(vkkit::Device& device, VkDeviceSize size) : device_(d
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(device.handle(), probe, &req);
   vkDestroyBuffer(device.handle(), probe, nullptr);
-  // The first type the buffers accept: lavapipe's only type, host-visible (vkMapMemory below fails loudly
-  // on a device where it is not).
-  uint32_t type = 0;
-  bool found = false;
-  for (uint32_t t = 0; t < 32 && !found; ++t) {
-    if (req.memoryTypeBits & (1u << t)) {
-      type = t;
-      found = true;
-    }
-  }
-  if (!found) throw std::runtime_error("SharedMemory: no memory type");
+  // Host-visible and coherent, so that tests can write inputs through one mapping (lavapipe has one such
+  // type; discrete GPUs have several types and map only these).
+  const uint32_t type = device.FindMemoryType(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
