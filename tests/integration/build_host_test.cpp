@@ -79,7 +79,8 @@ TEST_CASE("pInfos-03725: host scratch that runs past the end of the app's mappin
   // one allocation, whose next byte is no mapping.)
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   alloc.allocationSize = 1 << 16;
-  alloc.memoryTypeIndex = 0;  // lavapipe's only type, host-visible
+  // Host-visible (lavapipe's only type; on discrete GPUs type 0 is often device-local and cannot be mapped).
+  alloc.memoryTypeIndex = device.FindMemoryType(~0u, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   REQUIRE(vkAllocateMemory(device.handle(), &alloc, nullptr, &memory) == VK_SUCCESS);
   void* mapped = nullptr;
