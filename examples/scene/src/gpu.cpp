@@ -143,22 +143,34 @@ VkDeviceAddress Gpu::AddressOf(VkBuffer buffer) const {
   return vkGetBufferDeviceAddress(device_, &info);
 }
 
-Buffer Gpu::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, Memory memory) {
-  Buffer b;
-  b.size = size;
+VkBuffer Gpu::NewBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryRequirements* req) const {
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = size;
   info.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  Check(vkCreateBuffer(device_, &info, nullptr, &b.buffer), "vkCreateBuffer");
-  VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+  VkBuffer buffer = VK_NULL_HANDLE;
+  Check(vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
+  vkGetBufferMemoryRequirements(device_, buffer, req);
+  return buffer;
+}
+
+VkDeviceMemory Gpu::AllocateAddressable(VkDeviceSize size, uint32_t type_index) const {
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = FindMemoryType(req.memoryTypeBits, memory);
-  Check(vkAllocateMemory(device_, &alloc, nullptr, &b.memory), "vkAllocateMemory");
+  alloc.allocationSize = size;
+  alloc.memoryTypeIndex = type_index;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  Check(vkAllocateMemory(device_, &alloc, nullptr, &memory), "vkAllocateMemory");
+  return memory;
+}
+
+Buffer Gpu::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, Memory memory) {
+  Buffer b;
+  b.size = size;
+  VkMemoryRequirements req;
+  b.buffer = NewBuffer(size, usage, &req);
+  b.memory = AllocateAddressable(req.size, FindMemoryType(req.memoryTypeBits, memory));
   Check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
   if (memory == Memory::kHostVisible) Check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   b.address = AddressOf(b.buffer);
@@ -167,25 +179,18 @@ Buffer Gpu::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage, Memory mem
 
 MemoryBlock Gpu::CreateBlock(VkDeviceSize size, Memory memory) {
   // Ask a probe buffer which memory types suit buffers of the usages the scene binds into blocks.
-  VkBufferCreateInfo probe_info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  probe_info.size = 256;
-  probe_info.usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                     VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-  VkBuffer probe = VK_NULL_HANDLE;
-  Check(vkCreateBuffer(device_, &probe_info, nullptr, &probe), "vkCreateBuffer");
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, probe, &req);
-  vkDestroyBuffer(device_, probe, nullptr);
+  vkDestroyBuffer(device_,
+                  NewBuffer(256,
+                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
+                            &req),
+                  nullptr);
 
   MemoryBlock block;
   block.size = size;
   block.type_index = FindMemoryType(req.memoryTypeBits, memory);
-  VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
-  flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
-  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
-  alloc.allocationSize = size;
-  alloc.memoryTypeIndex = block.type_index;
-  Check(vkAllocateMemory(device_, &alloc, nullptr, &block.memory), "vkAllocateMemory");
+  block.memory = AllocateAddressable(size, block.type_index);
   if (memory == Memory::kHostVisible) {
     Check(vkMapMemory(device_, block.memory, 0, VK_WHOLE_SIZE, 0, &block.mapped), "vkMapMemory");
   }
@@ -195,13 +200,8 @@ MemoryBlock Gpu::CreateBlock(VkDeviceSize size, Memory memory) {
 Buffer Gpu::CreateBufferIn(MemoryBlock& block, VkDeviceSize size, VkBufferUsageFlags usage) {
   Buffer b;
   b.size = size;
-  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.size = size;
-  info.usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  Check(vkCreateBuffer(device_, &info, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+  b.buffer = NewBuffer(size, usage, &req);
   if (!(req.memoryTypeBits & (1u << block.type_index))) throw std::runtime_error("buffer does not fit the block's memory type");
   const VkDeviceSize offset = AlignUp(block.used, req.alignment);
   if (offset + req.size > block.size) throw std::runtime_error("memory block full");

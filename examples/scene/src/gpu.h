@@ -95,6 +95,10 @@ class Gpu {
 
  private:
   uint32_t FindMemoryType(uint32_t type_bits, Memory memory) const;
+  // An unbound buffer with SHADER_DEVICE_ADDRESS added to usage, and its memory requirements.
+  VkBuffer NewBuffer(VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryRequirements* req) const;
+  // Memory that device addresses may point into.
+  VkDeviceMemory AllocateAddressable(VkDeviceSize size, uint32_t type_index) const;
   VkDeviceAddress AddressOf(VkBuffer buffer) const;
 
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
