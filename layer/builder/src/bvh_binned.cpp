@@ -1,73 +1,187 @@
-// Binned SAH builder (default mode). Top-down; each node bins reference centroids on all three axes,
-// sweeps the bins for the cheapest SAH split and partitions in place. Subtrees above kSpawnRefs become
-// tasks that any thread may run; each task records its subtree as a pre-order byte code (1 byte per node,
-// no boxes), and the codes are expanded into the output in a fixed order, so the tree is identical for
-// every thread count. Boxes are recomputed from the references during that expansion: the build never
-// holds two copies of the tree (peak = references + tree + ids, not references + 2 x tree).
+// Binned SAH builder (default mode). Top-down; a node's references are binned by centroid on all three
+// axes, the bins are swept for the cheapest SAH split, and the references are partitioned in place.
+//
+// Binning and partitioning are one pass per level, not two: while a node's references are partitioned,
+// each is binned into its child's bins on a grid inherited from the parent (the split axis cut at the
+// split plane, the other axes unchanged). A child whose centroids turn out to fill less than
+// kLooseGrid of that grid on some axis is binned again on its own grid before it is split, so the
+// inherited grid never costs more than a factor of 1/kLooseGrid in bin resolution.
+//
+// Subtrees above kSpawnRefs become tasks that any thread may run; each task records its subtree as a
+// pre-order byte code (1 byte per node, no boxes), and the codes are expanded into the output in a fixed
+// order, so the tree is identical for every thread count. Boxes are recomputed from the references during
+// that expansion: the build never holds two copies of the tree (peak = references + tree + ids).
 #include <emmintrin.h>
 
 #include <algorithm>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
+#include <cstring>
 #include <memory>
-#include <mutex>
 #include <thread>
 
 #include "bvh_code.h"
+#include "bvh_task_queue.h"
 
 namespace asval::builder::detail {
 namespace {
 
 constexpr uint32_t kSpawnRefs = 4096;
 constexpr uint32_t kMaxBins = 64;
-constexpr uint32_t kSweepMax = 12;  // nodes this small get an exact SAH sweep instead of bins
+constexpr uint32_t kSweepMax = 12;    // nodes this small get an exact SAH sweep instead of bins
+constexpr uint32_t kExhaustiveMax = 5;
+// Nodes up to this size are partitioned out of place, in a per-thread scratch of at most 1/8 of the
+// references (2 MiB at most: peak memory stays within a few bytes per primitive).
+constexpr uint32_t kScratchRefs = 1u << 16;
+constexpr uint32_t kScratchMinRefs = 1u << 10;  // nodes this small try every bipartition
+constexpr float kLooseGrid = 0.5f;    // see the file comment
 
-class Queue {
-public:
-    void Push(Task* t) {
-        { std::lock_guard<std::mutex> l(mutex_); queue_.push_back(t); ++pending_; }
-        cv_.notify_one();
-    }
-    // Runs tasks until every pushed task (and those they push) has finished.
-    template <typename Fn>
-    void Work(Fn&& run) {
-        std::unique_lock<std::mutex> l(mutex_);
-        for (;;) {
-            if (!queue_.empty()) {
-                Task* t = queue_.front();
-                queue_.pop_front();
-                l.unlock();
-                run(t);
-                l.lock();
-                if (--pending_ == 0) cv_.notify_all();
-            } else if (pending_ == 0) {
-                return;
-            } else {
-                cv_.wait(l);
-            }
-        }
-    }
-
-private:
-    std::mutex mutex_;
-    std::condition_variable cv_;
-    std::deque<Task*> queue_;
-    uint32_t pending_ = 0;
-};
 
 struct Bin {
     __m128 lo, hi;
 };
 
+// Maps a reference's doubled centroid (lo + hi) to bin coordinates on the three axes at once:
+// t = (c * p - cmin * p) * q, clamped to [0, bins - 1]; the bin is trunc(t). p is a power of two keeping
+// tiny (subnormal) and huge extents in range; garbage lanes (NaN, inf) clamp and only cost quality.
+struct Grid {
+    __m128 p, cminp, q, maxBin;
+    alignas(16) float lo[4], hi[4];  // the centroid range the grid spans
+    alignas(16) float qs[4];         // q per axis; 0: the axis has no extent and is never split
+
+    __m128 Coord(__m128 c2) const {
+        const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);
+        return _mm_min_ps(_mm_max_ps(t, _mm_setzero_ps()), maxBin);  // NaN -> 0
+    }
+};
+
+Grid MakeGrid(const float lo[4], const float hi[4], uint32_t bins) {
+    Grid g;
+    alignas(16) float p[4] = {1, 1, 1, 1}, cminp[4] = {0, 0, 0, 0};
+    for (int a = 0; a < 4; ++a) { g.lo[a] = lo[a]; g.hi[a] = hi[a]; g.qs[a] = 0; }
+    for (int a = 0; a < 3; ++a) {
+        const double extent = double(hi[a]) - double(lo[a]);
+        if (!(extent > 0)) continue;
+        p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
+        g.qs[a] = float(double(bins) * (1 - 1e-6) / (extent * double(p[a])));
+        cminp[a] = lo[a] * p[a];
+    }
+    g.p = _mm_load_ps(p);
+    g.cminp = _mm_load_ps(cminp);
+    g.q = _mm_load_ps(g.qs);
+    g.maxBin = _mm_set1_ps(float(bins - 1));
+    return g;
+}
+
+// One node's bins: per axis, `bins` boxes and counts, on `grid`. `valid` is false until filled.
+struct BinSet {
+    Grid grid;
+    std::unique_ptr<Bin[]> box;  // [axis * bins + k]
+    std::unique_ptr<uint32_t[]> count;
+    bool valid = false;
+
+    explicit BinSet(uint32_t bins) : box(new Bin[3 * bins]), count(new uint32_t[3 * bins]) {}
+
+    void Reset(const Grid& g, uint32_t bins) {
+        grid = g;
+        for (uint32_t k = 0; k < 3 * bins; ++k) box[k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+        std::fill(count.get(), count.get() + 3 * bins, 0u);
+        valid = true;
+    }
+    void Add(const PrimRef& ref, __m128 c2, uint32_t bins) {
+        const __m128i k = _mm_cvttps_epi32(grid.Coord(c2));
+        const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
+        const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
+        const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
+        const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
+        box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
+        box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
+        box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
+    }
+
+    // Byte image for handing the bins to a spawned task.
+    void SaveTo(std::vector<uint8_t>* out, uint32_t bins) const {
+        const size_t boxBytes = sizeof(Bin) * 3 * bins, countBytes = sizeof(uint32_t) * 3 * bins;
+        out->resize(sizeof(Grid) + boxBytes + countBytes);
+        std::memcpy(out->data(), &grid, sizeof(Grid));
+        std::memcpy(out->data() + sizeof(Grid), box.get(), boxBytes);
+        std::memcpy(out->data() + sizeof(Grid) + boxBytes, count.get(), countBytes);
+    }
+    void LoadFrom(const std::vector<uint8_t>& in, uint32_t bins) {
+        const size_t boxBytes = sizeof(Bin) * 3 * bins, countBytes = sizeof(uint32_t) * 3 * bins;
+        std::memcpy(&grid, in.data(), sizeof(Grid));
+        std::memcpy(box.get(), in.data() + sizeof(Grid), boxBytes);
+        std::memcpy(count.get(), in.data() + sizeof(Grid) + boxBytes, countBytes);
+        valid = true;
+    }
+};
+
+// Per-thread bin storage: the bins of the two children of the node at depth d live in slot (d + 1, side),
+// so a node's bins survive while its left subtree is built (which only uses deeper slots).
+class Workspace {
+public:
+    explicit Workspace(uint32_t bins) : bins_(bins) {}
+    // Scratch for the out-of-place partition of nodes up to kScratchRefs references.
+    PrimRef* Scratch(uint32_t count) {
+        if (scratch_.size() < count) scratch_.resize(std::max<size_t>(count, 2 * scratch_.size()));
+        return scratch_.data();
+    }
+    BinSet* Slot(uint32_t depth, int side) {
+        const size_t i = size_t(depth) * 2 + size_t(side);
+        while (slots_.size() <= i) slots_.push_back(std::make_unique<BinSet>(bins_));
+        return slots_[i].get();
+    }
+
+private:
+    uint32_t bins_;
+    std::vector<std::unique_ptr<BinSet>> slots_;
+    std::vector<PrimRef> scratch_;
+};
+
+// Running box + centroid box of one side of a split.
+struct Side {
+    __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
+    __m128 clo = _mm_set1_ps(INFINITY), chi = _mm_set1_ps(-INFINITY);
+    void Add(const PrimRef& ref, __m128 c2) {
+        lo = _mm_min_ps(lo, LoadLo(ref));
+        hi = _mm_max_ps(hi, LoadHi(ref));
+        clo = MinKeep(clo, c2);
+        chi = MaxKeep(chi, c2);
+    }
+    void Add(const PrimRef& ref) { Add(ref, Centroid(ref)); }
+    Range ToRange(uint32_t b, uint32_t e, uint32_t depth) const { return Range{b, e, lo, hi, clo, chi, depth}; }
+};
+
+float Lane(__m128 v, int axis) {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return f[axis];
+}
+
+// A split chosen from a node's bins.
+struct BinSplit {
+    int axis = -1;
+    uint32_t bin = 0;       // references with bin < this go left
+    uint32_t leftCount = 0;
+    double cost = INFINITY;
+};
+
 class BinnedBuilder {
 public:
-    BinnedBuilder(PrimRef* refs, const BuildOptions& o, Queue* q)
+    BinnedBuilder(PrimRef* refs, uint32_t totalRefs, const BuildOptions& o, TaskQueue* q)
         : refs_(refs), bins_(std::clamp<uint32_t>(o.bins, 2, kMaxBins)),
-          maxLeaf_(std::clamp<uint32_t>(o.maxLeafSize, 1, 8)), queue_(q) {}
+          maxLeaf_(std::clamp<uint32_t>(o.maxLeafSize, 1, 8)),
+          scratchRefs_(std::clamp<uint32_t>(totalRefs / 8, kScratchMinRefs, kScratchRefs)), queue_(q) {}
 
-    void RunTask(Task* task) {
-        Build(task, task->range);
+    uint32_t Bins() const { return bins_; }
+
+    void RunTask(Task* task, Workspace* ws) {
+        BinSet* bins = ws->Slot(task->range.depth, 0);
+        bins->valid = false;
+        if (!task->carried.empty()) {
+            bins->LoadFrom(task->carried, bins_);
+            std::vector<uint8_t>().swap(task->carried);
+        }
+        Build(task, task->range, bins, ws);
         task->code.shrink_to_fit();
     }
 
@@ -75,35 +189,20 @@ private:
     PrimRef* refs_;
     uint32_t bins_;
     uint32_t maxLeaf_;
-    Queue* queue_;
+    uint32_t scratchRefs_;
+    TaskQueue* queue_;
 
     static void MakeLeaf(Task* task, const Range& r) { task->code.push_back(uint8_t(r.end - r.begin)); }
-
-    // Running box + centroid box of one side of a split.
-    struct Side {
-        __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-        __m128 clo = _mm_set1_ps(INFINITY), chi = _mm_set1_ps(-INFINITY);
-        void Add(const PrimRef& ref) {
-            lo = _mm_min_ps(lo, LoadLo(ref));
-            hi = _mm_max_ps(hi, LoadHi(ref));
-            const __m128 c = Centroid(ref);
-            clo = MinKeep(clo, c);
-            chi = MaxKeep(chi, c);
-        }
-        Range ToRange(uint32_t b, uint32_t e, uint32_t depth) const { return Range{b, e, lo, hi, clo, chi, depth}; }
-    };
-
-    static float Lane(__m128 v, int axis) {
-        alignas(16) float f[4];
-        _mm_store_ps(f, v);
-        return f[axis];
-    }
 
     // Full SAH sweep for small nodes: sort by centroid on each axis, evaluate every split position.
     // Returns false when no split exists (identical centroids on every axis).
     bool SweepSmall(const Range& r, double* bestCost, Range* left, Range* right) {
         constexpr uint32_t kMax = kSweepMax;
         const uint32_t count = r.end - r.begin;
+        if (count <= kExhaustiveMax) return BestSubsetSplit(r, bestCost, left, right);
+        const PrimRef* const refs = refs_ + r.begin;
+        alignas(16) float centroid[kMax][4];
+        for (uint32_t i = 0; i < count; ++i) _mm_store_ps(centroid[i], Centroid(refs[i]));
         struct Entry { float key; uint32_t index; };
         Entry order[3][kMax];
         double rightArea[kMax];
@@ -115,28 +214,28 @@ private:
             Entry* o = order[a];
             for (uint32_t i = 0; i < count; ++i) {
                 // Insertion sort; ties by position keep it deterministic.
-                const Entry e{Lane(Centroid(refs_[r.begin + i]), a), i};
+                const Entry e{centroid[i][a], i};
                 uint32_t k = i;
                 while (k > 0 && o[k - 1].key > e.key) { o[k] = o[k - 1]; --k; }
                 o[k] = e;
             }
             __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
             for (uint32_t k = count - 1; k > 0; --k) {
-                lo = _mm_min_ps(lo, LoadLo(refs_[r.begin + o[k].index]));
-                hi = _mm_max_ps(hi, LoadHi(refs_[r.begin + o[k].index]));
+                lo = _mm_min_ps(lo, LoadLo(refs[o[k].index]));
+                hi = _mm_max_ps(hi, LoadHi(refs[o[k].index]));
                 rightArea[k] = HalfArea(lo, hi);
             }
             lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
             for (uint32_t k = 0; k + 1 < count; ++k) {
-                lo = _mm_min_ps(lo, LoadLo(refs_[r.begin + o[k].index]));
-                hi = _mm_max_ps(hi, LoadHi(refs_[r.begin + o[k].index]));
+                lo = _mm_min_ps(lo, LoadLo(refs[o[k].index]));
+                hi = _mm_max_ps(hi, LoadHi(refs[o[k].index]));
                 const double cost = HalfArea(lo, hi) * (k + 1) + rightArea[k + 1] * (count - k - 1);
                 if (cost < *bestCost) { *bestCost = cost; bestAxis = a; bestSplit = k + 1; }
             }
         }
         if (bestAxis < 0) return false;
         PrimRef sorted[kMax];
-        for (uint32_t k = 0; k < count; ++k) sorted[k] = refs_[r.begin + order[bestAxis][k].index];
+        for (uint32_t k = 0; k < count; ++k) sorted[k] = refs[order[bestAxis][k].index];
         Side l, rr;
         for (uint32_t k = 0; k < count; ++k) {
             refs_[r.begin + k] = sorted[k];
@@ -147,118 +246,279 @@ private:
         return true;
     }
 
-    // Binned SAH for larger nodes. Returns false when no bin split exists.
-    bool Binned(const Range& r, double* bestCost, Range* left, Range* right) {
+    // Exact best split of a tiny node over every bipartition (a superset of the sweep's candidates):
+    // the boxes of all 2^n subsets are built incrementally, each from a smaller one.
+    bool BestSubsetSplit(const Range& r, double* bestCost, Range* left, Range* right) {
+        const uint32_t count = r.end - r.begin;
+        PrimRef* const refs = refs_ + r.begin;
+        const uint32_t full = (1u << count) - 1;
+        __m128 lo[1u << kExhaustiveMax], hi[1u << kExhaustiveMax];
+        double area[1u << kExhaustiveMax];
+        lo[0] = _mm_set1_ps(INFINITY);
+        hi[0] = _mm_set1_ps(-INFINITY);
+        for (uint32_t m = 1; m <= full; ++m) {
+            const uint32_t low = uint32_t(__builtin_ctz(m)), rest = m & (m - 1);
+            lo[m] = _mm_min_ps(lo[rest], LoadLo(refs[low]));
+            hi[m] = _mm_max_ps(hi[rest], LoadHi(refs[low]));
+            area[m] = HalfArea(lo[m], hi[m]);
+        }
+        // Element 0 always on the left: each bipartition once.
+        uint32_t best = 0;
+        *bestCost = INFINITY;
+        for (uint32_t m = 1; m < full; m += 2) {
+            const uint32_t n = uint32_t(__builtin_popcount(m));
+            const double cost = area[m] * n + area[full ^ m] * (count - n);
+            if (cost < *bestCost) { *bestCost = cost; best = m; }
+        }
+        if (best == 0) return false;
+        PrimRef sorted[kExhaustiveMax];
+        uint32_t nl = 0, nr = uint32_t(__builtin_popcount(best));
+        const uint32_t split = nr;
+        for (uint32_t i = 0; i < count; ++i) sorted[(best >> i) & 1 ? nl++ : nr++] = refs[i];
+        std::copy(sorted, sorted + count, refs);
+        *left = Range{r.begin, r.begin + split, lo[best], hi[best], _mm_setzero_ps(), _mm_setzero_ps(), r.depth + 1};
+        *right = Range{r.begin + split, r.end, lo[full ^ best], hi[full ^ best], _mm_setzero_ps(), _mm_setzero_ps(), r.depth + 1};
+        CentroidBounds(left);
+        CentroidBounds(right);
+        return true;
+    }
+
+    void CentroidBounds(Range* r) const {
+        Side s;
+        for (uint32_t i = r->begin; i < r->end; ++i) s.Add(refs_[i]);
+        r->clo = s.clo;
+        r->chi = s.chi;
+    }
+
+    // Bins a node's references on its own grid (the root, and children whose inherited grid was loose).
+    void BinOwnGrid(const Range& r, BinSet* bins) {
         alignas(16) float clo[4], chi[4];
         _mm_store_ps(clo, r.clo);
         _mm_store_ps(chi, r.chi);
-        // Bin coordinate t = (c * p - cmin * p) * q, p a power of two keeping tiny (subnormal) and huge
-        // extents in range; garbage lanes clamp into [0, bins) and only cost quality.
-        alignas(16) float p[4] = {1, 1, 1, 1}, q[4] = {0, 0, 0, 0}, cminp[4] = {0, 0, 0, 0};
-        for (int a = 0; a < 3; ++a) {
-            const double extent = double(chi[a]) - double(clo[a]);
-            if (!(extent > 0)) continue;
-            p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
-            q[a] = float(double(bins_) * (1 - 1e-6) / (extent * double(p[a])));
-            cminp[a] = clo[a] * p[a];
-        }
-        const __m128 P = _mm_load_ps(p), Q = _mm_load_ps(q), CminP = _mm_load_ps(cminp);
-        const __m128 maxBin = _mm_set1_ps(float(bins_ - 1)), zero = _mm_setzero_ps();
-        auto binOf = [&](const PrimRef& ref) {
-            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(ref), P), CminP), Q);
-            return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(t, zero), maxBin));  // NaN -> 0
-        };
+        bins->Reset(MakeGrid(clo, chi, bins_), bins_);
+        for (uint32_t i = r.begin; i < r.end; ++i) bins->Add(refs_[i], Centroid(refs_[i]), bins_);
+    }
 
-        // Two bin sets, alternating by reference, so consecutive references landing in the same bin do not
-        // serialise on one memory location; merged before the sweep. Each reference's three bin indices are
-        // kept in its `aux` field for the partition pass.
-        Bin bins[2][3][kMaxBins];
-        uint32_t counts[2][3][kMaxBins] = {};
-        for (int s2 = 0; s2 < 2; ++s2)
-            for (int a = 0; a < 3; ++a)
-                for (uint32_t k = 0; k < bins_; ++k) bins[s2][a][k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
-        auto binOne = [&](PrimRef& ref, int set) {
-            const __m128i ki = binOf(ref);
-            const uint32_t k[3] = {uint32_t(_mm_cvtsi128_si32(ki)), uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(ki, 4))),
-                                   uint32_t(_mm_cvtsi128_si32(_mm_srli_si128(ki, 8)))};
-            const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
-            for (int a = 0; a < 3; ++a) {
-                Bin& b = bins[set][a][k[a]];
-                b.lo = _mm_min_ps(b.lo, lo);
-                b.hi = _mm_max_ps(b.hi, hi);
-                ++counts[set][a][k[a]];
-            }
-            ref.aux = k[0] | k[1] << 8 | k[2] << 16;
-        };
-        uint32_t i = r.begin;
-        for (; i + 1 < r.end; i += 2) {
-            binOne(refs_[i], 0);
-            binOne(refs_[i + 1], 1);
-        }
-        if (i < r.end) binOne(refs_[i], 0);
-        for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins_; ++k) {
-                bins[0][a][k].lo = _mm_min_ps(bins[0][a][k].lo, bins[1][a][k].lo);
-                bins[0][a][k].hi = _mm_max_ps(bins[0][a][k].hi, bins[1][a][k].hi);
-                counts[0][a][k] += counts[1][a][k];
-            }
-        int axis = -1;
-        uint32_t splitBin = 0;
-        *bestCost = INFINITY;
+    // The cheapest split between bins; axis -1 when none exists.
+    BinSplit BestBinSplit(const BinSet& bins) const {
+        BinSplit best;
         for (int a = 0; a < 3; ++a) {
-            if (q[a] == 0) continue;
+            if (bins.grid.qs[a] == 0) continue;
+            const Bin* box = &bins.box[a * bins_];
+            const uint32_t* count = &bins.count[a * bins_];
             double rightArea[kMaxBins];
             uint32_t rightCount[kMaxBins];
             __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
             uint32_t n = 0;
             for (uint32_t k = bins_ - 1; k > 0; --k) {
-                lo = _mm_min_ps(lo, bins[0][a][k].lo);
-                hi = _mm_max_ps(hi, bins[0][a][k].hi);
-                n += counts[0][a][k];
+                lo = _mm_min_ps(lo, box[k].lo);
+                hi = _mm_max_ps(hi, box[k].hi);
+                n += count[k];
                 rightArea[k] = HalfArea(lo, hi);
                 rightCount[k] = n;
             }
             lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
             n = 0;
             for (uint32_t k = 0; k + 1 < bins_; ++k) {
-                lo = _mm_min_ps(lo, bins[0][a][k].lo);
-                hi = _mm_max_ps(hi, bins[0][a][k].hi);
-                n += counts[0][a][k];
+                lo = _mm_min_ps(lo, box[k].lo);
+                hi = _mm_max_ps(hi, box[k].hi);
+                n += count[k];
                 if (n == 0 || rightCount[k + 1] == 0) continue;
                 const double cost = HalfArea(lo, hi) * n + rightArea[k + 1] * rightCount[k + 1];
-                if (cost < *bestCost) { *bestCost = cost; axis = a; splitBin = k + 1; }
+                if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = k + 1; best.leftCount = n; }
             }
         }
-        if (axis < 0) return false;
-        // Partition by the bin index the binning pass stored, measuring each side as it is visited.
-        const unsigned shift = 8u * unsigned(axis);
-        auto isLeft = [&](const PrimRef& ref) { return ((ref.aux >> shift) & 0xFFu) < splitBin; };
-        Side l, rr;
-        i = r.begin;
-        uint32_t j = r.end;
-        for (;;) {
-            while (i < j && isLeft(refs_[i])) l.Add(refs_[i++]);
-            while (i < j && !isLeft(refs_[j - 1])) rr.Add(refs_[--j]);
-            if (i >= j) break;
-            std::swap(refs_[i], refs_[j - 1]);
-            l.Add(refs_[i++]);
-            rr.Add(refs_[--j]);
-        }
-        *left = l.ToRange(r.begin, i, r.depth + 1);
-        *right = rr.ToRange(i, r.end, r.depth + 1);
-        return true;
+        return best;
     }
 
-    void Build(Task* task, Range r) {
+    // The child's grid inherited from the parent's: the split axis cut at the split plane.
+    Grid ChildGrid(const Grid& parent, const BinSplit& s, bool left) const {
+        alignas(16) float lo[4], hi[4];
+        std::copy(parent.lo, parent.lo + 4, lo);
+        std::copy(parent.hi, parent.hi + 4, hi);
+        const int a = s.axis;
+        const float plane = float(double(parent.lo[a]) + (double(parent.hi[a]) - double(parent.lo[a])) * s.bin / bins_);
+        (left ? hi : lo)[a] = plane;
+        return MakeGrid(lo, hi, bins_);
+    }
+
+    // A binned child's range from its bins: the box is exact (the union of its bins on one axis); the
+    // centroid box is the span of its occupied bins, a slight superset, used only to re-bin and for the
+    // median fallback. Marks the bins for re-binning when the centroids fill too little of the grid.
+    Range RangeFromBins(uint32_t begin, uint32_t end, uint32_t depth, BinSet* bins) const {
+        Range r{begin, end, _mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY), _mm_setzero_ps(), _mm_setzero_ps(), depth};
+        for (uint32_t k = 0; k < bins_; ++k) {
+            r.lo = _mm_min_ps(r.lo, bins->box[k].lo);
+            r.hi = _mm_max_ps(r.hi, bins->box[k].hi);
+        }
+        alignas(16) float clo[4] = {0, 0, 0, 0}, chi[4] = {0, 0, 0, 0};
+        const Grid& g = bins->grid;
+        for (int a = 0; a < 3; ++a) {
+            clo[a] = g.lo[a];
+            chi[a] = g.hi[a];
+            if (g.qs[a] == 0) continue;
+            const uint32_t* count = &bins->count[a * bins_];
+            uint32_t kmin = 0, kmax = bins_ - 1;
+            while (kmin < kmax && count[kmin] == 0) ++kmin;
+            while (kmax > kmin && count[kmax] == 0) --kmax;
+            if (float(kmax - kmin + 1) < kLooseGrid * float(bins_)) bins->valid = false;
+            const double w = (double(g.hi[a]) - double(g.lo[a])) / bins_;
+            if (kmin > 0) clo[a] = float(double(g.lo[a]) + w * kmin);
+            if (kmax + 1 < bins_) chi[a] = float(double(g.lo[a]) + w * (kmax + 1));
+        }
+        r.clo = _mm_load_ps(clo);
+        r.chi = _mm_load_ps(chi);
+        return r;
+    }
+
+    Range RangeFromRefs(uint32_t begin, uint32_t end, uint32_t depth) const {
+        Side side;
+        for (uint32_t i = begin; i < end; ++i) side.Add(refs_[i]);
+        return side.ToRange(begin, end, depth);
+    }
+
+    // Partitions by the chosen split and bins every reference into its child's bins in the same pass.
+    void PartitionAndBin(const Range& r, const BinSet& bins, const BinSplit& s, Range* left, Range* right,
+                         BinSet* leftBins, BinSet* rightBins, Workspace* ws) {
+        leftBins->Reset(ChildGrid(bins.grid, s, true), bins_);
+        rightBins->Reset(ChildGrid(bins.grid, s, false), bins_);
+        uint32_t mid;
+        if (r.end - r.begin <= scratchRefs_) {
+            PrimRef* scratch = ws->Scratch(r.end - r.begin);
+            switch (s.axis) {
+                case 0: mid = PartitionCopy<0>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 1: mid = PartitionCopy<1>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                default: mid = PartitionCopy<2>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+            }
+        } else {
+            switch (s.axis) {
+                case 0: mid = PartitionLoop<0>(r, bins.grid, s.bin, leftBins, rightBins); break;
+                case 1: mid = PartitionLoop<1>(r, bins.grid, s.bin, leftBins, rightBins); break;
+                default: mid = PartitionLoop<2>(r, bins.grid, s.bin, leftBins, rightBins); break;
+            }
+        }
+        const uint32_t d = r.depth + 1;
+        *left = mid - r.begin > kSweepMax ? RangeFromBins(r.begin, mid, d, leftBins) : RangeFromRefs(r.begin, mid, d);
+        *right = r.end - mid > kSweepMax ? RangeFromBins(mid, r.end, d, rightBins) : RangeFromRefs(mid, r.end, d);
+        if (mid - r.begin <= kSweepMax) leftBins->valid = false;
+        if (r.end - mid <= kSweepMax) rightBins->valid = false;
+    }
+
+    // Branch-free out-of-place partition: each reference is written to both ends of the scratch and
+    // the side it belongs to advances, so the unpredictable side decision never becomes a branch.
+    template <int kAxis>
+    uint32_t PartitionCopy(const Range& r, const Grid& node, uint32_t splitBin, BinSet* leftBins,
+                           BinSet* rightBins, PrimRef* scratch) {
+        const Grid gl = leftBins->grid, gr = rightBins->grid;
+        Bin* const lbox = leftBins->box.get();
+        Bin* const rbox = rightBins->box.get();
+        uint32_t* const lcount = leftBins->count.get();
+        uint32_t* const rcount = rightBins->count.get();
+        const __m128 p = node.p, cminp = node.cminp, q = node.q, splitAt = _mm_set1_ps(float(splitBin));
+        const uint32_t bins = bins_;
+        PrimRef* const refs = refs_ + r.begin;
+        const uint32_t count = r.end - r.begin;
+        uint32_t l = 0, rr = count;
+        for (uint32_t i = 0; i < count; ++i) {
+            const __m128 lo = LoadLo(refs[i]), hi = LoadHi(refs[i]);
+            const __m128 c2 = _mm_add_ps(lo, hi);
+            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);
+            const uint32_t left = uint32_t(_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) >> kAxis) & 1u;
+            _mm_store_ps(scratch[l].lo, lo);
+            _mm_store_ps(scratch[l].hi, hi);
+            _mm_store_ps(scratch[rr - 1].lo, lo);
+            _mm_store_ps(scratch[rr - 1].hi, hi);
+            l += left;
+            rr -= left ^ 1u;
+            const __m128i kl = _mm_cvttps_epi32(gl.Coord(c2)), kr = _mm_cvttps_epi32(gr.Coord(c2));
+            const __m128i sel = _mm_set1_epi32(-int(left));
+            const __m128i k = _mm_or_si128(_mm_and_si128(sel, kl), _mm_andnot_si128(sel, kr));
+            Bin* const box = left ? lbox : rbox;
+            uint32_t* const cnt = left ? lcount : rcount;
+            const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
+            const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
+            const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
+            box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++cnt[k0];
+            box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++cnt[k1];
+            box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++cnt[k2];
+        }
+        std::memcpy(static_cast<void*>(refs), scratch, sizeof(PrimRef) * count);
+        return r.begin + l;
+    }
+
+    // Kept small so that the three grids stay in registers: no running boxes here (they come from bins).
+    template <int kAxis>
+    uint32_t PartitionLoop(const Range& r, const Grid& node, uint32_t splitBin, BinSet* leftBins, BinSet* rightBins) {
+        const Grid gl = leftBins->grid, gr = rightBins->grid;
+        Bin* const lbox = leftBins->box.get();
+        Bin* const rbox = rightBins->box.get();
+        uint32_t* const lcount = leftBins->count.get();
+        uint32_t* const rcount = rightBins->count.get();
+        const __m128 p = node.p, cminp = node.cminp, q = node.q, splitAt = _mm_set1_ps(float(splitBin));
+        const uint32_t bins = bins_;
+        // Left iff trunc(clamp(t)) < splitBin, i.e. !(t >= splitBin) (NaN clamps to bin 0): the node's
+        // own binning decision, bit for bit.
+        auto isLeft = [&](__m128 c2) {
+            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);
+            return (_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) & (1 << kAxis)) != 0;
+        };
+        auto add = [bins](const Grid& g, Bin* box, uint32_t* count, const PrimRef& ref, __m128 c2) {
+            const __m128i k = _mm_cvttps_epi32(g.Coord(c2));
+            const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
+            const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
+            const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
+            const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
+            box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
+            box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
+            box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
+        };
+        PrimRef* const refs = refs_;
+        uint32_t i = r.begin, j = r.end;
+        for (;;) {
+            __m128 ci = _mm_setzero_ps(), cj = _mm_setzero_ps();
+            for (; i < j; ++i) {
+                ci = Centroid(refs[i]);
+                if (!isLeft(ci)) break;
+                add(gl, lbox, lcount, refs[i], ci);
+            }
+            for (; i < j; --j) {
+                cj = Centroid(refs[j - 1]);
+                if (isLeft(cj)) break;
+                add(gr, rbox, rcount, refs[j - 1], cj);
+            }
+            if (i >= j) break;
+            std::swap(refs[i], refs[j - 1]);
+            add(gl, lbox, lcount, refs[i++], cj);
+            add(gr, rbox, rcount, refs[--j], ci);
+        }
+        return i;
+    }
+
+    void Build(Task* task, Range r, BinSet* bins, Workspace* ws) {
         const uint32_t count = r.end - r.begin;
         if (count == 1) { MakeLeaf(task, r); return; }
         const bool forceMedian = r.depth + HalvingLevels(count, maxLeaf_) >= kMaxDepth;
         if (forceMedian && count <= maxLeaf_) { MakeLeaf(task, r); return; }
 
+        BinSet* leftBins = ws->Slot(r.depth + 1, 0);
+        BinSet* rightBins = ws->Slot(r.depth + 1, 1);
+        leftBins->valid = rightBins->valid = false;
         Range left, right;
         double cost = INFINITY;
         bool found = false;
-        if (!forceMedian) found = count <= kSweepMax ? SweepSmall(r, &cost, &left, &right) : Binned(r, &cost, &left, &right);
+        if (!forceMedian) {
+            if (count <= kSweepMax) {
+                found = SweepSmall(r, &cost, &left, &right);
+            } else {
+                if (!bins->valid) BinOwnGrid(r, bins);
+                const BinSplit s = BestBinSplit(*bins);
+                if (s.axis >= 0) {
+                    found = true;
+                    cost = s.cost;
+                    PartitionAndBin(r, *bins, s, &left, &right, leftBins, rightBins, ws);
+                }
+            }
+        }
         if (count <= maxLeaf_) {
             const double nodeArea = HalfArea(r.lo, r.hi);
             if (!found || !(nodeArea + cost < nodeArea * count)) { MakeLeaf(task, r); return; }
@@ -285,47 +545,40 @@ private:
             task->code.push_back(kCodeInnerSpawned);
             auto child = std::make_unique<Task>();
             child->range = right;
+            if (rightBins->valid) rightBins->SaveTo(&child->carried, bins_);
             Task* raw = child.get();
             task->children.push_back(std::move(child));
             queue_->Push(raw);
-            Build(task, left);
+            Build(task, left, leftBins, ws);
         } else {
             task->code.push_back(kCodeInner);
-            Build(task, left);
-            Build(task, right);
+            Build(task, left, leftBins, ws);
+            Build(task, right, rightBins, ws);
         }
     }
 };
-
 
 }  // namespace
 
 Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
     Bvh bvh;
     if (refs.empty()) return bvh;
-    Queue queue;
-    BinnedBuilder builder(refs.data(), options, &queue);
+    TaskQueue queue;
+    BinnedBuilder builder(refs.data(), uint32_t(refs.size()), options, &queue);
     Task root;
     {
-        Range r{};
-        __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY), clo = lo, chi = hi;
-        for (const PrimRef& ref : refs) {
-            lo = _mm_min_ps(lo, LoadLo(ref));
-            hi = _mm_max_ps(hi, LoadHi(ref));
-            const __m128 c = Centroid(ref);
-            clo = MinKeep(clo, c);
-            chi = MaxKeep(chi, c);
-        }
-        r.begin = 0; r.end = uint32_t(refs.size());
-        r.lo = lo; r.hi = hi; r.clo = clo; r.chi = chi; r.depth = 1;
-        root.range = r;
+        Side all;
+        for (const PrimRef& ref : refs) all.Add(ref);
+        root.range = all.ToRange(0, uint32_t(refs.size()), 1);
     }
     queue.Push(&root);
-    auto run = [&builder](Task* t) { builder.RunTask(t); };
+    auto work = [&builder, &queue] {
+        Workspace ws(builder.Bins());
+        queue.Work([&](Task* t) { builder.RunTask(t, &ws); });
+    };
     std::vector<std::thread> workers;
-    for (uint32_t i = 1; i < std::max<uint32_t>(options.threads, 1); ++i)
-        workers.emplace_back([&queue, &run] { queue.Work(run); });
-    queue.Work(run);
+    for (uint32_t i = 1; i < std::max<uint32_t>(options.threads, 1); ++i) workers.emplace_back(work);
+    work();
     for (auto& w : workers) w.join();
 
     // Expand the codes (boxes come from the references), then take the ids and free the references.

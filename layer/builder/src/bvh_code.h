@@ -4,6 +4,7 @@
 // expanded into the output, once, after the build.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -30,6 +31,7 @@ struct Task {
     std::vector<uint8_t> code;  // code[0] is this task's root
     std::vector<std::unique_ptr<Task>> children;  // spawned right subtrees, in pre-order
     uint32_t rootSlot = 0;  // output slot of code[0]; set while the parent is expanded
+    std::vector<uint8_t> carried;  // builder state handed from the spawning task (binned SAH: the root's bins)
 };
 
 // Nodes the tasks recorded, all of them.
