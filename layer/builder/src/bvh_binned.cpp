@@ -32,7 +32,8 @@ constexpr uint32_t kExhaustiveMax = 5;
 // Nodes up to this size are partitioned out of place, in a per-thread scratch of at most 1/8 of the
 // references (2 MiB at most: peak memory stays within a few bytes per primitive).
 constexpr uint32_t kScratchRefs = 1u << 16;
-constexpr uint32_t kScratchMinRefs = 1u << 10;  // nodes this small try every bipartition
+constexpr uint32_t kScratchMinRefs = 1u << 10;
+constexpr uint32_t kSideSample = 32;  // references sampled to choose the partition loop  // nodes this small try every bipartition
 constexpr float kLooseGrid = 0.5f;    // see the file comment
 
 
@@ -246,6 +247,15 @@ private:
         return true;
     }
 
+    // Bits set in a mask below 2^kExhaustiveMax (the portable builtin becomes a library call without
+    // -mpopcnt, which this library does not assume).
+    static uint32_t PopCount5(uint32_t m) {
+        static_assert(kExhaustiveMax <= 5, "table size");
+        static constexpr uint8_t kBits[32] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,
+                                              1, 2, 2, 3, 2, 3, 3, 4, 2, 3, 3, 4, 3, 4, 4, 5};
+        return kBits[m];
+    }
+
     // Exact best split of a tiny node over every bipartition (a superset of the sweep's candidates):
     // the boxes of all 2^n subsets are built incrementally, each from a smaller one.
     bool BestSubsetSplit(const Range& r, double* bestCost, Range* left, Range* right) {
@@ -266,13 +276,13 @@ private:
         uint32_t best = 0;
         *bestCost = INFINITY;
         for (uint32_t m = 1; m < full; m += 2) {
-            const uint32_t n = uint32_t(__builtin_popcount(m));
+            const uint32_t n = PopCount5(m);
             const double cost = area[m] * n + area[full ^ m] * (count - n);
             if (cost < *bestCost) { *bestCost = cost; best = m; }
         }
         if (best == 0) return false;
         PrimRef sorted[kExhaustiveMax];
-        uint32_t nl = 0, nr = uint32_t(__builtin_popcount(best));
+        uint32_t nl = 0, nr = PopCount5(best);
         const uint32_t split = nr;
         for (uint32_t i = 0; i < count; ++i) sorted[(best >> i) & 1 ? nl++ : nr++] = refs[i];
         std::copy(sorted, sorted + count, refs);
@@ -385,10 +395,16 @@ private:
         uint32_t mid;
         if (r.end - r.begin <= scratchRefs_) {
             PrimRef* scratch = ws->Scratch(r.end - r.begin);
-            switch (s.axis) {
-                case 0: mid = PartitionCopy<0>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                case 1: mid = PartitionCopy<1>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                default: mid = PartitionCopy<2>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+            // Both loops give the same result; which is faster depends on how often the side changes
+            // from one reference to the next (coherent meshes: rarely, and a branch predicts well).
+            const bool masked = SideChangesOften(r, bins.grid, s);
+            switch (s.axis * 2 + int(masked)) {
+                case 0: mid = PartitionCopy<0, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 1: mid = PartitionCopy<0, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 2: mid = PartitionCopy<1, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 3: mid = PartitionCopy<1, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 4: mid = PartitionCopy<2, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                default: mid = PartitionCopy<2, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
             }
         } else {
             switch (s.axis) {
@@ -404,9 +420,23 @@ private:
         if (r.end - mid <= kSweepMax) rightBins->valid = false;
     }
 
+    // Samples the first references: does the side flip often enough that a branch on it would mispredict?
+    bool SideChangesOften(const Range& r, const Grid& g, const BinSplit& s) const {
+        const uint32_t n = std::min<uint32_t>(r.end - r.begin, kSideSample);
+        const __m128 splitAt = _mm_set1_ps(float(s.bin));
+        uint32_t changes = 0, previous = 2;
+        for (uint32_t i = 0; i < n; ++i) {
+            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(refs_[r.begin + i]), g.p), g.cminp), g.q);
+            const uint32_t left = uint32_t(_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) >> s.axis) & 1u;
+            changes += uint32_t(previous != 2 && left != previous);
+            previous = left;
+        }
+        return changes * 4 > n;
+    }
+
     // Branch-free out-of-place partition: each reference is written to both ends of the scratch and
     // the side it belongs to advances, so the unpredictable side decision never becomes a branch.
-    template <int kAxis>
+    template <int kAxis, bool kMasked>
     uint32_t PartitionCopy(const Range& r, const Grid& node, uint32_t splitBin, BinSet* leftBins,
                            BinSet* rightBins, PrimRef* scratch) {
         const Grid gl = leftBins->grid, gr = rightBins->grid;
@@ -418,6 +448,9 @@ private:
         const uint32_t bins = bins_;
         PrimRef* const refs = refs_ + r.begin;
         const uint32_t count = r.end - r.begin;
+        const uintptr_t rboxBits = reinterpret_cast<uintptr_t>(rbox), rcountBits = reinterpret_cast<uintptr_t>(rcount);
+        const uintptr_t boxDiff = reinterpret_cast<uintptr_t>(lbox) ^ rboxBits;
+        const uintptr_t countDiff = reinterpret_cast<uintptr_t>(lcount) ^ rcountBits;
         uint32_t l = 0, rr = count;
         for (uint32_t i = 0; i < count; ++i) {
             const __m128 lo = LoadLo(refs[i]), hi = LoadHi(refs[i]);
@@ -433,8 +466,20 @@ private:
             const __m128i kl = _mm_cvttps_epi32(gl.Coord(c2)), kr = _mm_cvttps_epi32(gr.Coord(c2));
             const __m128i sel = _mm_set1_epi32(-int(left));
             const __m128i k = _mm_or_si128(_mm_and_si128(sel, kl), _mm_andnot_si128(sel, kr));
-            Bin* const box = left ? lbox : rbox;
-            uint32_t* const cnt = left ? lcount : rcount;
+            Bin* box;
+            uint32_t* cnt;
+            if (kMasked) {
+                // Selected by mask, not by `?:`: the compiler turns that into a branch.
+                const uintptr_t pick = uintptr_t(0) - uintptr_t(left);
+                box = reinterpret_cast<Bin*>(rboxBits ^ (boxDiff & pick));
+                cnt = reinterpret_cast<uint32_t*>(rcountBits ^ (countDiff & pick));
+            } else if (left) {
+                box = lbox;
+                cnt = lcount;
+            } else {
+                box = rbox;
+                cnt = rcount;
+            }
             const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
             const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
             const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
