@@ -160,4 +160,78 @@ Triangle ClassifyTriangle(const TriangleInput& in, uint32_t t) {
     return r;
 }
 
+// ---- Motion (VK_NV_ray_tracing_motion_blur) ----
+
+namespace {
+
+// The three vertices of triangle t read from `vertexData` (same indexing rules as ClassifyTriangle).
+void FetchMotionVertices(const TriangleInput& in, const uint8_t* vertexData, uint32_t t, Vertex v[3], uint64_t index[3]) {
+    const unsigned indexBytes = in.indexType == VK_INDEX_TYPE_UINT16 ? 2
+                              : in.indexType == VK_INDEX_TYPE_UINT32 ? 4
+                              : in.indexType == VK_INDEX_TYPE_NONE_KHR ? 0 : 1;
+    for (unsigned k = 0; k < 3; ++k) {
+        uint64_t byteOffset;
+        if (indexBytes != 0) {
+            index[k] = ReadLE(in.indexData + in.primitiveOffset + (3ull * t + k) * indexBytes, indexBytes);
+            byteOffset = (index[k] + in.firstVertex) * in.stride;
+        } else {
+            index[k] = 3ull * t + k;
+            byteOffset = in.primitiveOffset + (uint64_t(in.firstVertex) + 3ull * t + k) * in.stride;
+        }
+        DecodeVertex(in.format, vertexData + byteOffset, &v[k]);
+    }
+}
+
+bool SameValue(const Component& a, const Component& b) { return !a.nan && !b.nan && a.value == b.value; }
+
+}  // namespace
+
+Triangle ClassifyMotionTriangle(const TriangleInput& in, const uint8_t* vertexData1, uint32_t t) {
+    Triangle r;
+    Vertex v[2][3];
+    uint64_t index[3];
+    FetchMotionVertices(in, in.vertexData, t, v[0], index);
+    FetchMotionVertices(in, vertexData1, t, v[1], index);
+    for (const auto& time : v)
+        for (const auto& vert : time) {
+            if (vert.c[0].nan) r.active = false;
+            r.undefined |= vert.c[1].nan || vert.c[2].nan;
+        }
+    if (!r.active) { r.undefined = false; return r; }
+    // Degenerate at every t: the spec's condition is an "or" of statements, each an "and" of equalities
+    // between two components. Component differences interpolate linearly in t, so an equality holds at every
+    // t exactly when it holds at both ends. Listing each statement as pairs (vertex a, vertex b, axis):
+    struct Eq { int a, b, axis; };
+    const Eq statements[6][6] = {
+        // "one or more vertices whose respective (X), (Y), (Z) components are identical" (pairs 01, 12, 02)
+        {{0, 1, 0}, {0, 1, 1}, {0, 1, 2}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}},
+        {{1, 2, 0}, {1, 2, 1}, {1, 2, 2}, {1, 2, 0}, {1, 2, 0}, {1, 2, 0}},
+        {{0, 2, 0}, {0, 2, 1}, {0, 2, 2}, {0, 2, 0}, {0, 2, 0}, {0, 2, 0}},
+        // "three vertices that have at least two of the (X), (Y), or (Z) components identical": XY, XZ, YZ
+        {{0, 1, 0}, {1, 2, 0}, {0, 1, 1}, {1, 2, 1}, {0, 1, 0}, {0, 1, 0}},
+        {{0, 1, 0}, {1, 2, 0}, {0, 1, 2}, {1, 2, 2}, {0, 1, 0}, {0, 1, 0}},
+        {{0, 1, 1}, {1, 2, 1}, {0, 1, 2}, {1, 2, 2}, {0, 1, 1}, {0, 1, 1}},
+    };
+    for (const auto& st : statements) {
+        bool always = true;
+        for (const Eq& e : st)
+            for (const auto& time : v) always &= SameValue(time[e.a].c[e.axis], time[e.b].c[e.axis]);
+        r.degenerate |= always;
+    }
+    if (in.indexType != VK_INDEX_TYPE_NONE_KHR)
+        r.sameIndex = index[0] == index[1] || index[1] == index[2] || index[0] == index[2];
+    return r;
+}
+
+int MotionInstanceActivity(const uint8_t* data, uint32_t primitiveOffset, uint32_t i) {
+    const uint8_t* rec = data + primitiveOffset + 160ull * i;
+    const uint64_t type = ReadLE(rec, 4);
+    // data (the union) follows type and flags at offset 8. Reference offsets from the structure
+    // definitions: static = 48-byte transform + 2 x 4-byte bit-field words; matrix = 2 x 48 + 8;
+    // SRT = 2 x 64 (16 floats each) + 8.
+    const uint64_t at = type == 0 ? 8 + 48 + 8 : type == 1 ? 8 + 96 + 8 : type == 2 ? 8 + 128 + 8 : 0;
+    if (at == 0) return -1;
+    return ReadLE(rec + at, 8) != 0 ? 1 : 0;
+}
+
 }  // namespace oracle

@@ -45,4 +45,16 @@ struct TriangleInput {
 // Classifies triangle `t` per "Inactive Primitives and Instances" / "Degenerate Primitives and Instances".
 Triangle ClassifyTriangle(const TriangleInput& in, uint32_t t);
 
+// VK_NV_ray_tracing_motion_blur triangles: `vertexData1` holds the positions at time 1.0 ("indexing ... is
+// equivalent to the basic vertex position data"); positions interpolate linearly in between. The project's
+// decision for the spec's silence: the six vertices are all "vertices" of the triangle, so inactive iff an
+// X at either time is NaN, undefined iff a Y/Z at either time is NaN (X not), and degenerate iff the
+// triangle is degenerate at every time in [0, 1].
+Triangle ClassifyMotionTriangle(const TriangleInput& in, const uint8_t* vertexData1, uint32_t t);
+
+// Activity of record i of a plain VkAccelerationStructureMotionInstanceNV array ("stride of 160 bytes")
+// starting at `primitiveOffset`: 1 active, 0 inactive ("acceleration structure reference is 0"), -1 when
+// the type is not one of the three the spec defines.
+int MotionInstanceActivity(const uint8_t* data, uint32_t primitiveOffset, uint32_t i);
+
 }  // namespace oracle

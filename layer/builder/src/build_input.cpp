@@ -11,6 +11,8 @@
 #include "asval/builder/vertex_format.h"
 #include "conservative_bounds.h"
 #include "format_traits.h"
+#include "motion_instances.h"
+#include "motion_triangles.h"
 
 namespace asval::builder {
 namespace {
@@ -99,9 +101,51 @@ bool Keep(uint8_t s, bool allowUpdate, BuildInput* out) {
     return true;
 }
 
+// Motion triangles: the union of the conservative boxes of the triangle at time 0 and at time 1. A vertex
+// at time t is (1 - t) v0 + t v1 and the (affine) transform keeps that a convex combination of the two
+// transformed ends, so the triangle at every t lies in the hull of its six transformed vertices.
+void AppendMotionTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    const uint32_t n = view.range.primitiveCount;
+    std::vector<uint8_t> states(n);
+    const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());  // the motion rules
+    if (cr.status != ClassifyStatus::Ok) { out->excludedUnreadable += n; return; }
+    const VertexFormatInfo& info = *FindVertexFormat(view.vertexFormat);
+    const int indexBytes = IndexTypeBytes(view.indexType);
+    float m[12];
+    const bool transformed = view.transformData && !cr.transformUnreadable;
+    if (transformed)
+        std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
+    const uint8_t* const buffers[2] = {static_cast<const uint8_t*>(view.vertexData),
+                                       static_cast<const uint8_t*>(view.motionVertexData)};
+    out->refs.reserve(out->refs.size() + n);
+    for (uint32_t t = 0; t < n; ++t) {
+        if (!Keep(states[t], allowUpdate, out)) continue;
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int k = 0; k < 3; ++k) {
+            const uint64_t off = detail::MotionVertexOffset(view, indexBytes, t, k);  // readable at both times
+            for (const uint8_t* vb : buffers) {
+                float vlo[3], vhi[3];
+                VertexInterval(info, vb + off, vlo, vhi);
+                if (transformed) {
+                    float tlo[3], thi[3];
+                    TransformBoxConservative(m, vlo, vhi, tlo, thi);
+                    std::memcpy(vlo, tlo, sizeof vlo);
+                    std::memcpy(vhi, thi, sizeof vhi);
+                }
+                for (int c = 0; c < 3; ++c) {
+                    lo[c] = vlo[c] < lo[c] ? vlo[c] : lo[c];
+                    hi[c] = vhi[c] > hi[c] ? vhi[c] : hi[c];
+                }
+            }
+        }
+        Put(out, idBase + t, lo, hi);
+    }
+}
+
 }  // namespace
 
 void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    if (view.motionVertexData) { AppendMotionTriangles(view, allowUpdate, idBase, out); return; }
     const uint32_t n = view.range.primitiveCount;
     std::vector<uint8_t> states(n);
     const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());
@@ -185,8 +229,34 @@ void AppendAabbs(const AabbGeometryView& view, bool allowUpdate, uint32_t idBase
     }
 }
 
+namespace {
+
+// Motion instances: the record's own reference field; boxes conservative over every time in [0, 1]
+// (motion_instances.cpp). Exclusions as for static instances.
+void AppendMotionInstances(const InstanceGeometryView& view, BlasLookup lookup, void* user, uint32_t idBase,
+                           BuildInput* out) {
+    const uint32_t n = view.range.primitiveCount;
+    std::vector<uint8_t> states(n);
+    ClassifyInstances(view, nullptr, states.data());
+    out->refs.reserve(out->refs.size() + n);
+    for (uint32_t i = 0; i < n; ++i) {
+        if (!Keep(states[i], true, out)) continue;
+        const detail::MotionRecord rec = detail::LocateMotionInstance(view, i);  // Ok: the classifier read it
+        const BlasSummary blas = lookup ? lookup(detail::MotionReference(rec), user) : BlasSummary{};
+        if (!blas.known) { ++out->excludedInvalid; continue; }
+        const bool degenerate = blas.activePrimitives == 0;
+        float lo[3], hi[3];
+        detail::MotionInstanceBox(rec, blas.lo, blas.hi, degenerate, lo, hi);
+        out->degenerateInstances += degenerate;
+        Put(out, idBase + i, lo, hi);
+    }
+}
+
+}  // namespace
+
 void AppendInstances(const InstanceGeometryView& view, BlasLookup lookup, void* user, uint32_t idBase,
                      BuildInput* out) {
+    if (view.motionInstances) { AppendMotionInstances(view, lookup, user, idBase, out); return; }
     const uint32_t n = view.range.primitiveCount;
     std::vector<uint8_t> states(n);
     ClassifyInstances(view, nullptr, states.data());

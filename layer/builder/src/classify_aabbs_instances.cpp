@@ -1,6 +1,7 @@
 // AABB and instance classification (triangles are in classify_triangles.cpp).
 #include "asval/builder/classify.h"
 #include "format_traits.h"
+#include "motion_instances.h"
 
 namespace asval::builder {
 namespace {
@@ -46,6 +47,33 @@ struct Recorder {
 void NoteUnreadable(ClassifyResult& r, uint32_t i) {
     ++r.unreadable;
     if (r.firstUnreadable == UINT32_MAX) r.firstUnreadable = i;
+}
+
+// Motion instances (VK_NV_ray_tracing_motion_blur): "An inactive instance is one whose acceleration
+// structure reference is 0", read from the reference field of the record's own type. Nothing else (mask,
+// NaN in either transform) changes activity. Records that cannot be read are recorded active.
+ClassifyResult ClassifyMotionInstances(const InstanceGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    ClassifyResult r;
+    const uint32_t n = view.range.primitiveCount;
+    r.primitiveCount = n;
+    Recorder rec = Recorder::Start(record, states, n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const MotionRecord m = LocateMotionInstance(view, i);
+        if (m.status != MotionRecord::Ok) {
+            if (m.status == MotionRecord::NullPointer) ++r.nullInstancePointer;
+            if (m.status == MotionRecord::InvalidType) {
+                ++r.invalidMotionType;
+                if (r.firstInvalidMotionType == UINT32_MAX) r.firstInvalidMotionType = i;
+            }
+            NoteUnreadable(r, i);
+            rec.Put(i, kStateActive | kStateUnreadable);
+            continue;
+        }
+        r.nonZeroMotionFlags += m.flags != 0;
+        rec.Put(i, MotionReference(m) != 0 ? kStateActive : 0);
+    }
+    rec.Finish(n, r);
+    return r;
 }
 
 }  // namespace
@@ -98,6 +126,7 @@ ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* recor
 }
 
 ClassifyResult ClassifyInstances(const InstanceGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    if (view.motionInstances) return ClassifyMotionInstances(view, record, states);
     ClassifyResult r;
     const uint32_t n = view.range.primitiveCount;
     r.primitiveCount = n;

@@ -1,31 +1,23 @@
 // Spatial pre-splitting of oversized triangle references (see bvh_triangles.h).
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <vector>
 
 #include "asval/builder/bvh_triangles.h"
 #include "asval/builder/vertex_format.h"
-#include "conservative_bounds.h"
+#include "bvh_internal.h"
 #include "format_traits.h"
+#include "lbvh_hugepages.h"
+#include "presplit_clip.h"
+#include "presplit_parallel.h"
 
 namespace asval::builder {
 namespace {
 
 constexpr uint32_t kMaxPiecesPerTriangle = 128;
 constexpr double kTrigger = 16.0;  // Auto splits only when the largest box exceeds 16x the mean box area
-
-double Area(const float lo[3], const float hi[3]) {
-    double e[3];
-    for (int a = 0; a < 3; ++a) e[a] = std::max(0.0, double(hi[a]) - double(lo[a]));
-    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
-}
-
-bool Finite(const PrimRef& r) {
-    for (int a = 0; a < 3; ++a)
-        if (!std::isfinite(r.lo[a]) || !std::isfinite(r.hi[a])) return false;
-    return true;
-}
 
 // Triangle vertices in the BVH's frame, in double: exact for untransformed float formats, within 2^-50
 // (relative) otherwise, which the clipping margin covers.
@@ -69,84 +61,26 @@ private:
     std::vector<uint32_t> bases_;
 };
 
-struct Poly {
-    double v[9][3];  // a triangle clipped by up to 6 planes has at most 9 vertices
-    int n = 0;
+struct Candidate {
+    double area;
+    uint32_t index;
 };
 
-// Keeps the part of `in` with sign * (x[axis] - c) <= 0.
-void ClipPlane(const Poly& in, int axis, double c, double sign, Poly* out) {
-    out->n = 0;
-    for (int i = 0; i < in.n; ++i) {
-        const double* a = in.v[i];
-        const double* b = in.v[i + 1 == in.n ? 0 : i + 1];  // not `% n`: a division per edge showed in profiles
-        const double da = sign * (a[axis] - c), db = sign * (b[axis] - c);
-        if (da <= 0 && out->n < 9) std::memcpy(out->v[out->n++], a, sizeof(double) * 3);
-        if (((da < 0 && db > 0) || (da > 0 && db < 0)) && out->n < 9) {
-            const double t = da / (da - db);
-            double* p = out->v[out->n++];
-            for (int k = 0; k < 3; ++k) p[k] = a[k] + t * (b[k] - a[k]);
-            p[axis] = c;
-        }
-    }
+// References per chunk of the area scans, candidates per chunk of the splitting (fixed: the output must
+// not depend on the thread count).
+constexpr size_t kScanChunk = 1 << 16;
+constexpr size_t kSplitChunk = 64;  // small: candidates come largest first, so early chunks hold most pieces
+
+// Half surface area of a box, in double (HalfArea: e0*e1 + e1*e2 + e2*e0); 0 for a box with an infinite or
+// NaN bound, which is never split.
+inline double FiniteArea(const PrimRef& r) {
+    const __m128 big = _mm_set1_ps(FLT_MAX);
+    const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+    const __m128 lo = detail::LoadLo(r), hi = detail::LoadHi(r);
+    const int ok = _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(_mm_and_ps(lo, absMask), big),
+                                              _mm_cmple_ps(_mm_and_ps(hi, absMask), big)));
+    return (ok & 7) == 7 ? detail::HalfArea(lo, hi) : 0.0;
 }
-
-class Splitter {
-public:
-    Splitter(const double tri[3][3], double margin, double threshold, std::vector<PrimRef>* out)
-        : margin_(margin), threshold_(threshold), out_(out) {
-        std::memcpy(tri_, tri, sizeof tri_);
-    }
-
-    // Emits pieces of `box` (a conservative box of the triangle part inside it); `cap` pieces at most.
-    void Split(const PrimRef& box, uint32_t cap) {
-        if (cap <= 1 || Area(box.lo, box.hi) <= threshold_) { out_->push_back(box); return; }
-        int axis = 0;
-        for (int a = 1; a < 3; ++a)
-            if (double(box.hi[a]) - box.lo[a] > double(box.hi[axis]) - box.lo[axis]) axis = a;
-        const float mid = float(0.5 * (double(box.lo[axis]) + double(box.hi[axis])));
-        if (!(mid > box.lo[axis] && mid < box.hi[axis])) { out_->push_back(box); return; }
-        PrimRef halves[2] = {box, box};
-        halves[0].hi[axis] = mid;
-        halves[1].lo[axis] = mid;
-        PrimRef kept[2];
-        int n = 0;
-        for (const PrimRef& h : halves)
-            if (Clip(h, &kept[n])) ++n;
-        if (n == 0) { out_->push_back(box); return; }  // cannot happen for a non-empty part; stay safe
-        if (n == 1) { Split(kept[0], cap); return; }
-        Split(kept[0], cap / 2);
-        Split(kept[1], cap - cap / 2);
-    }
-
-private:
-    // Bounds of the triangle inside `cell` widened by the margin, widened again, rounded outward and
-    // intersected with `cell`. False when nothing of the triangle is inside.
-    bool Clip(const PrimRef& cell, PrimRef* out) const {
-        Poly a, b;
-        a.n = 3;
-        std::memcpy(a.v, tri_, sizeof tri_);
-        for (int axis = 0; axis < 3; ++axis) {
-            ClipPlane(a, axis, double(cell.hi[axis]) + margin_, 1.0, &b);
-            ClipPlane(b, axis, double(cell.lo[axis]) - margin_, -1.0, &a);
-            if (a.n == 0) return false;
-        }
-        *out = cell;
-        for (int axis = 0; axis < 3; ++axis) {
-            double lo = INFINITY, hi = -INFINITY;
-            for (int i = 0; i < a.n; ++i) { lo = std::min(lo, a.v[i][axis]); hi = std::max(hi, a.v[i][axis]); }
-            out->lo[axis] = std::max(cell.lo[axis], detail::RoundDown(lo - margin_));
-            out->hi[axis] = std::min(cell.hi[axis], detail::RoundUp(hi + margin_));
-            if (out->lo[axis] > out->hi[axis]) return false;
-        }
-        return true;
-    }
-
-    double tri_[3][3];
-    double margin_;
-    double threshold_;
-    std::vector<PrimRef>* out_;
-};
 
 }  // namespace
 
@@ -154,73 +88,104 @@ uint32_t SplitLargeTriangles(const TriangleGeometryView* geometries, size_t geom
                              const BuildOptions& options, BuildInput* input) {
     std::vector<PrimRef>& refs = input->refs;
     if (options.spatialSplits == SpatialSplits::Off || refs.empty()) return 0;
+    // Pieces clip the time-0 triangle only: a moving triangle would leave its pieces at t > 0.
+    for (size_t g = 0; g < geometryCount; ++g)
+        if (geometries[g].motionVertexData) return 0;
+    const uint32_t threads = std::max<uint32_t>(options.threads, 1);
+    const size_t n = refs.size();
+    // Every pass below works in fixed chunks whose results are combined in chunk order, so the output is
+    // the same for any thread count (the area sum too: its rounding depends on the chunking only).
+    const size_t scanChunks = (n + kScanChunk - 1) / kScanChunk;
+    struct Scan {
+        double sum = 0, largest = 0;
+        std::vector<Candidate> candidates;
+    };
+    std::vector<Scan> scans(scanChunks);
+    detail::ForEachChunk(threads, scanChunks, [&](size_t c) {
+        Scan& s = scans[c];
+        for (size_t i = c * kScanChunk, e = std::min(n, i + kScanChunk); i < e; ++i) {
+            const double a = FiniteArea(refs[i]);
+            s.sum += a;
+            s.largest = std::max(s.largest, a);
+        }
+    });
     double sum = 0, largest = 0;
-    for (const PrimRef& r : refs) {
-        const double a = Finite(r) ? Area(r.lo, r.hi) : 0.0;
-        sum += a;
-        largest = std::max(largest, a);
-    }
-    const double mean = sum / double(refs.size());
+    for (const Scan& s : scans) { sum += s.sum; largest = std::max(largest, s.largest); }
+    const double mean = sum / double(n);
     // "Needs splits": some reference is far larger than the average one. Measured max/mean: uniform 3.6,
     // sphere 1.5, terrain 2.0, clustered 380-455 (10k..1M). On meshes nothing below runs.
     if (options.spatialSplits == SpatialSplits::Auto && !(largest > kTrigger * mean)) return 0;
     const double threshold = double(options.splitFactor) * mean;
-    struct Candidate {
-        double area;
-        uint32_t index;
-    };
+    const uint64_t budget = uint64_t(double(n) * std::max(0.0f, options.splitBudget));
+    if (budget == 0) return 0;
+    detail::ForEachChunk(threads, scanChunks, [&](size_t c) {
+        Scan& s = scans[c];
+        for (size_t i = c * kScanChunk, e = std::min(n, i + kScanChunk); i < e; ++i) {
+            const double a = FiniteArea(refs[i]);  // 0 for an infinite box: never a candidate
+            if (a > threshold) s.candidates.push_back({a, uint32_t(i)});
+        }
+    });
     std::vector<Candidate> byArea;
-    for (uint32_t i = 0; i < refs.size(); ++i) {
-        if (!Finite(refs[i])) continue;
-        const double a = Area(refs[i].lo, refs[i].hi);
-        if (a > threshold) byArea.push_back({a, i});
+    {
+        size_t total = 0;
+        for (const Scan& s : scans) total += s.candidates.size();
+        byArea.reserve(total);
+        for (Scan& s : scans) {
+            byArea.insert(byArea.end(), s.candidates.begin(), s.candidates.end());
+            std::vector<Candidate>().swap(s.candidates);
+        }
     }
     if (byArea.empty()) return 0;
-    const uint64_t budget = uint64_t(double(refs.size()) * std::max(0.0f, options.splitBudget));
-    if (budget == 0) return 0;
     // Largest first; the budget is shared out in proportion to area. Areas are computed once (a
     // comparator computing them dominated this function).
     std::sort(byArea.begin(), byArea.end(), [](const Candidate& x, const Candidate& y) {
         return x.area > y.area || (x.area == y.area && x.index < y.index);
     });
-    std::vector<uint32_t> candidates(byArea.size());
     double candidateArea = 0;
-    for (size_t c = 0; c < byArea.size(); ++c) {
-        candidates[c] = byArea[c].index;
-        candidateArea += byArea[c].area;
-    }
-    // Piece caps first, so the reference array grows once (no doubling on push_back).
-    std::vector<uint32_t> caps(candidates.size());
+    for (const Candidate& c : byArea) candidateArea += c.area;
+    std::vector<uint32_t> caps(byArea.size());
     uint64_t capSum = 0;
-    for (size_t c = 0; c < candidates.size(); ++c) {
+    for (size_t c = 0; c < byArea.size(); ++c) {
         const double share = double(budget) * byArea[c].area / candidateArea;
         const uint64_t left = budget > capSum ? budget - capSum : 0;
         caps[c] = uint32_t(std::min<double>({double(kMaxPiecesPerTriangle), share + 1, double(left + 1)}));
         if (caps[c] >= 2) capSum += caps[c] - 1;
     }
-    std::vector<Candidate>().swap(byArea);
-    refs.reserve(refs.size() + capSum);
+    // Cut the candidates in chunks: each chunk replaces its references by their first pieces (distinct
+    // elements of refs) and keeps the other pieces, in candidate order, for the append below.
     const TriangleFetcher fetch(geometries, geometryCount);
-    std::vector<PrimRef> pieces;
-    uint64_t added = 0;
-    for (size_t c = 0; c < candidates.size(); ++c) {
-        const uint32_t i = candidates[c];
-        const PrimRef original = refs[i];
-        const uint32_t cap = caps[c];
-        if (cap < 2) continue;
-        double tri[3][3];
-        fetch.Fetch(original.id, tri);
-        double magnitude = 0;
-        for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::fabs(double(original.lo[a])), std::fabs(double(original.hi[a]))});
-        pieces.clear();
-        Splitter(tri, magnitude * 0x1p-40, threshold, &pieces).Split(original, cap);
-        refs[i] = pieces[0];
-        for (size_t k = 1; k < pieces.size(); ++k) refs.push_back(pieces[k]);
-        added += pieces.size() - 1;
+    const size_t splitChunks = (byArea.size() + kSplitChunk - 1) / kSplitChunk;
+    std::vector<std::vector<PrimRef>> extra(splitChunks);
+    detail::ForEachChunk(threads, splitChunks, [&](size_t chunk) {
+        std::vector<PrimRef> pieces;
+        std::vector<PrimRef>& more = extra[chunk];
+        for (size_t c = chunk * kSplitChunk, e = std::min(byArea.size(), c + kSplitChunk); c < e; ++c) {
+            if (caps[c] < 2) continue;
+            PrimRef& ref = refs[byArea[c].index];
+            double tri[3][3];
+            fetch.Fetch(ref.id, tri);
+            double magnitude = 0;
+            for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::fabs(double(ref.lo[a])), std::fabs(double(ref.hi[a]))});
+            pieces.clear();
+            detail::PieceSplitter(tri, magnitude * 0x1p-40, threshold).Split(ref, caps[c], &pieces);
+            ref = pieces[0];
+            more.insert(more.end(), pieces.begin() + 1, pieces.end());
+        }
+    });
+    std::vector<Candidate>().swap(byArea);
+    size_t added = 0;
+    for (const auto& m : extra) added += m.size();
+    if (added == 0) return 0;
+    // One exact-size array: no growth, no unused tail carried into the build's peak.
+    std::vector<PrimRef> merged;
+    detail::ReserveHuge(merged, n + added);
+    merged.insert(merged.end(), refs.begin(), refs.end());
+    std::vector<PrimRef>().swap(refs);
+    for (auto& m : extra) {
+        merged.insert(merged.end(), m.begin(), m.end());
+        std::vector<PrimRef>().swap(m);
     }
-    // The caps are upper bounds (clustered: 1.40x reserved for 1.16x used): return the unused tail so the
-    // build's peak (references + tree) does not carry it. The copy's own peak is below the build's.
-    if (refs.capacity() - refs.size() > refs.size() / 32) refs.shrink_to_fit();
+    refs.swap(merged);
     return uint32_t(added);
 }
 

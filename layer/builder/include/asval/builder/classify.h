@@ -43,6 +43,11 @@ struct ClassifyResult {
     uint32_t invalidAabb = 0;
     uint32_t overMaxVertex = 0;       // triangles reading a vertex above maxVertex (VUID 10774 / 10775)
     uint32_t nullInstancePointer = 0; // arrayOfPointers entries that are null (counted unreadable too)
+    // Motion instances: a type outside STATIC / MATRIX_MOTION / SRT_MOTION (VUID-VkAccelerationStructure-
+    // MotionInstanceNV-type-parameter): its layout is unknown, so it is counted unreadable too (active).
+    uint32_t invalidMotionType = 0;
+    uint32_t firstInvalidMotionType = UINT32_MAX;
+    uint32_t nonZeroMotionFlags = 0;  // plain motion records with flags != 0 (...-flags-zerobitmask)
     bool transformHasNaN = false;     // a NaN in the 3x4 transform (warning; activity unchanged)
     bool transformUnreadable = false; // transform pointer set but its 48 bytes at transformOffset not provided
     bool indexHashPartial = false;    // index bytes missing: the hash covers only what was provided
@@ -60,6 +65,14 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
 ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* record, uint8_t* states);
 // Instances: active iff accelerationStructureReference != 0. Mask 0 is active. Degenerate instances (BLAS
 // without active primitives) need the BLAS records: see build_input.h.
+// Motion instances (view.motionInstances): the same rule on the reference field of the record's type
+// (static, matrix or SRT); a NaN anywhere in a motion transform does not change activity (the spec's
+// inactive rule for instances names only the reference).
+// Motion triangles (view.motionVertexData): inactive iff the X component of any of the six vertices (three
+// at time 0, three at time 1) is NaN; undefined-input iff a Y/Z is NaN at either time and no X is;
+// degenerate iff degenerate at *every* time in [0, 1], i.e. one clause of the spec's definition (a vertex
+// pair identical, or all three sharing the same two axes) holds at time 0 and at time 1 (see
+// motion_triangles.cpp); unreadable iff either time's data is missing.
 ClassifyResult ClassifyInstances(const InstanceGeometryView& view, ActivityRecord* record, uint8_t* states);
 
 }  // namespace asval::builder
