@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "alloc_counter.h"
+#include "resident_peak.h"
 #include "asval/builder/bvh_triangles.h"
 
 namespace bench {
@@ -20,6 +21,7 @@ const scenes::Scene& CachedScene(const std::string& name, uint32_t triangles) {
 BuildRun RunBuild(const scenes::Scene& s, const asval::builder::BuildOptions& o) {
     using clock = std::chrono::steady_clock;
     BuildRun r;
+    const size_t residentBefore = resident::StartSpan();
     alloccount::ResetPeak();
     const size_t before = alloccount::CurrentBytes();
     timespec c0, c1;
@@ -36,6 +38,8 @@ BuildRun RunBuild(const scenes::Scene& s, const asval::builder::BuildOptions& o)
     r.cpuSeconds = double(c1.tv_sec - c0.tv_sec) + 1e-9 * double(c1.tv_nsec - c0.tv_nsec);
     bvh.stats.splitReferences = added;
     r.peakBytes = alloccount::PeakBytes() - before;
+    const size_t residentPeak = resident::PeakSinceStart();
+    r.peakResidentBytes = residentPeak > residentBefore ? residentPeak - residentBefore : 0;
     r.seconds = std::chrono::duration<double>(t2 - t0).count();
     r.prepareSeconds = std::chrono::duration<double>(t1 - t0).count();
     r.sah = asval::builder::SahCost(bvh);

@@ -16,7 +16,8 @@ struct BuildRun {
     double cpuSeconds = 0;       // the same span in process CPU time (robust to other load on the machine)
     double prepareSeconds = 0;   // AppendTriangles alone (classification + conservative boxes)
     double sah = 0;
-    size_t peakBytes = 0;        // heap peak above the scene itself
+    size_t peakBytes = 0;        // heap peak above the scene itself: every byte allocated, touched or not
+    size_t peakResidentBytes = 0;  // resident (RSS) peak above the start of the build (0: unsupported)
     asval::builder::BuildStats stats;
 };
 

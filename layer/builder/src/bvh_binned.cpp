@@ -626,11 +626,10 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
     work();
     for (auto& w : workers) w.join();
 
-    // Expand the codes (boxes come from the references), then take the ids and free the references.
+    // Expand the codes (boxes and ids come from the references, released as they are read), then free them.
     bvh.nodes.resize(CountNodes(root));
-    ExpandCodes(refs.data(), root, bvh.nodes.data(), &bvh.stats);
     bvh.primIds.resize(refs.size());
-    for (size_t i = 0; i < refs.size(); ++i) bvh.primIds[i] = refs[i].id;
+    ExpandCodes(refs.data(), refs.size(), root, bvh.nodes.data(), bvh.primIds.data(), &bvh.stats);
     std::vector<PrimRef>().swap(refs);
     return bvh;
 }

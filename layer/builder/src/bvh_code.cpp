@@ -1,68 +1,70 @@
 // Expansion of recorded codes into BvhNodes (see bvh_code.h).
 #include "bvh_code.h"
 
+#include "page_release.h"
+
 #include <cmath>
 
 namespace asval::builder::detail {
 namespace {
 
+// Expands in one global pre-order: a spawned child task is expanded where its parent's code names it, so
+// leaves take the references strictly front to back (a spawned task's range is the right subtree's, which
+// follows the left one's) and slots are handed out in the same order. That is what lets the references be
+// released while the output is written (page_release.h).
 class Expander {
 public:
-    Expander(const PrimRef* refs, BvhNode* out, BuildStats* stats) : refs_(refs), out_(out), stats_(stats) {}
+    Expander(PrimRef* refs, size_t refCount, BvhNode* out, uint32_t* ids, BuildStats* stats)
+        : refs_(refs), out_(out), ids_(ids), stats_(stats), release_(refs, refCount * sizeof(PrimRef)) {}
 
-    void Expand(Task& t) {
-        State s{&t, 0, 1, 0, end_, t.range.begin};
-        // Local slots: the root, then one pair per inner node; a spawned right child's slot is counted
-        // here (its code[0] is in the child task). Local slots 1.. map to base + slot - 1.
-        end_ += uint32_t(t.code.size() + t.children.size()) - 1;
+    void Expand(Task& root) {
+        cursor_ = root.range.begin;
+        Cursor c{&root, 0, 0};
         __m128 lo, hi;
-        Node(s, t.rootSlot, t.range.depth, &lo, &hi);
-        std::vector<uint8_t>().swap(t.code);
-        for (auto& child : t.children) Expand(*child);
+        Node(c, 0, root.range.depth, &lo, &hi);
+        std::vector<uint8_t>().swap(root.code);
     }
 
 private:
-    struct State {
+    struct Cursor {
         Task* task;
-        size_t pos;         // next code byte
-        uint32_t nextLocal; // next local slot pair
-        size_t child;       // next child task
-        uint32_t base;      // global slot of local slot 1
-        uint32_t cursor;    // first reference of the next leaf
+        size_t pos;    // next code byte of `task`
+        size_t child;  // next spawned child of `task`
     };
 
-    void Node(State& s, uint32_t slot, uint32_t depth, __m128* lo, __m128* hi) {
-        const uint8_t c = s.task->code[s.pos++];
+    void Node(Cursor& c, uint32_t slot, uint32_t depth, __m128* lo, __m128* hi) {
+        const uint8_t code = c.task->code[c.pos++];
         BvhNode& n = out_[slot];
         if (depth > stats_->maxDepth) stats_->maxDepth = depth;
-        if (c != kCodeInner && c != kCodeInnerSpawned) {
+        if (code != kCodeInner && code != kCodeInnerSpawned) {
             ++stats_->leaves;
-            if (c > stats_->maxLeafSize) stats_->maxLeafSize = c;
+            if (code > stats_->maxLeafSize) stats_->maxLeafSize = code;
             __m128 l = _mm_set1_ps(INFINITY), h = _mm_set1_ps(-INFINITY);
-            for (uint32_t i = s.cursor; i < s.cursor + c; ++i) {
+            for (uint32_t i = cursor_; i < cursor_ + code; ++i) {
                 l = _mm_min_ps(l, LoadLo(refs_[i]));
                 h = _mm_max_ps(h, LoadHi(refs_[i]));
+                if (ids_) ids_[i] = refs_[i].id;
             }
             StoreNodeBox(n, l, h);
-            n.leftOrFirst = s.cursor;
-            n.count = c;
-            s.cursor += c;
+            n.leftOrFirst = cursor_;
+            n.count = code;
+            cursor_ += code;
+            release_.Consumed(size_t(cursor_) * sizeof(PrimRef));
             *lo = l; *hi = h;
             return;
         }
-        const uint32_t left = s.base + s.nextLocal - 1;
-        s.nextLocal += 2;
+        const uint32_t left = next_;
+        next_ += 2;
         // The spawned child was pushed before any spawned inside the left subtree: take it first.
-        Task* spawned = c == kCodeInnerSpawned ? s.task->children[s.child++].get() : nullptr;
+        Task* spawned = code == kCodeInnerSpawned ? c.task->children[c.child++].get() : nullptr;
         __m128 llo, lhi, rlo, rhi;
-        Node(s, left, depth + 1, &llo, &lhi);
+        Node(c, left, depth + 1, &llo, &lhi);
         if (spawned) {
-            Task& child = *spawned;
-            child.rootSlot = left + 1;
-            rlo = child.range.lo; rhi = child.range.hi;
-            s.cursor = child.range.end;
+            Cursor sc{spawned, 0, 0};
+            Node(sc, left + 1, depth + 1, &rlo, &rhi);
+            std::vector<uint8_t>().swap(spawned->code);
         } else {
-            Node(s, left + 1, depth + 1, &rlo, &rhi);
+            Node(c, left + 1, depth + 1, &rlo, &rhi);
         }
         *lo = _mm_min_ps(llo, rlo);
         *hi = _mm_max_ps(lhi, rhi);
@@ -71,10 +73,13 @@ private:
         n.count = 0;
     }
 
-    const PrimRef* refs_;
+    PrimRef* refs_;
     BvhNode* out_;
+    uint32_t* ids_;
     BuildStats* stats_;
-    uint32_t end_ = 1;  // out_[0] is the root
+    PageReleaser release_;
+    uint32_t next_ = 1;  // next free slot pair; out_[0] is the root
+    uint32_t cursor_ = 0;  // first reference of the next leaf
 };
 
 }  // namespace
@@ -85,9 +90,8 @@ size_t CountNodes(const Task& t) {
     return n;
 }
 
-void ExpandCodes(const PrimRef* refs, Task& root, BvhNode* out, BuildStats* stats) {
-    root.rootSlot = 0;
-    Expander(refs, out, stats).Expand(root);
+void ExpandCodes(PrimRef* refs, size_t refCount, Task& root, BvhNode* out, uint32_t* ids, BuildStats* stats) {
+    Expander(refs, refCount, out, ids, stats).Expand(root);
 }
 
 }  // namespace asval::builder::detail

@@ -30,18 +30,18 @@ struct Task {
     Range range;
     std::vector<uint8_t> code;  // code[0] is this task's root
     std::vector<std::unique_ptr<Task>> children;  // spawned right subtrees, in pre-order
-    uint32_t rootSlot = 0;  // output slot of code[0]; set while the parent is expanded
     std::vector<uint8_t> carried;  // builder state handed from the spawning task (binned SAH: the root's bins)
 };
 
 // Nodes the tasks recorded, all of them.
 size_t CountNodes(const Task& root);
 
-// Writes the tree into out[0, CountNodes(root)): the root at out[0], a task's other nodes contiguous (inner
-// nodes' child pairs in the order they were recorded), then its child tasks, each in full, in order; a
-// child task's root sits in the slot its parent reserved. Leaves tile the references in pre-order (a
-// task's leaves start at range.begin; its root is at depth range.depth). Frees the codes as it goes.
-// Counts leaves, the largest leaf and the depth into `stats` (which starts zeroed).
-void ExpandCodes(const PrimRef* refs, Task& root, BvhNode* out, BuildStats* stats);
+// Writes the tree into out[0, CountNodes(root)): the root at out[0], then one slot pair per inner node in
+// pre-order (a spawned child task expanded where its parent names it). Leaves tile the references in
+// pre-order (the root task starts at range.begin, depth range.depth). When `ids` is not null it receives
+// each reference's id at the reference's index. The references are read once, front to back, and their
+// pages may be released as they are (they must not be read afterwards; free them next). Frees the codes as
+// it goes. Counts leaves, the largest leaf and the depth into `stats` (which starts zeroed).
+void ExpandCodes(PrimRef* refs, size_t refCount, Task& root, BvhNode* out, uint32_t* ids, BuildStats* stats);
 
 }  // namespace asval::builder::detail

@@ -130,7 +130,7 @@ Bvh BuildLbvh(std::vector<PrimRef>& refs, const BuildOptions& options) {
     }
     ReserveHuge(bvh.nodes, CountNodes(tree));
     bvh.nodes.resize(bvh.nodes.capacity());
-    ExpandCodes(refs.data(), tree, bvh.nodes.data(), &bvh.stats);
+    ExpandCodes(refs.data(), refs.size(), tree, bvh.nodes.data(), nullptr, &bvh.stats);
     std::vector<PrimRef>().swap(refs);
     return bvh;
 }

@@ -11,6 +11,9 @@
 namespace asval::builder {
 
 struct BvhNode {
+    // Left uninitialised on purpose: the builders size the output before writing it front to back, and a
+    // zero-filled vector would make every page resident at once (see docs/builder.md, "Memory").
+    BvhNode() {}  // NOLINT(modernize-use-equals-default): `= default` would zero-fill in value-initialisation
     float lo[3];
     uint32_t leftOrFirst;  // inner: index of the left child (the right one follows); leaf: first reference
     float hi[3];
