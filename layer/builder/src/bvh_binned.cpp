@@ -1,16 +1,21 @@
 // Binned SAH builder (default mode). Top-down; a node's references are binned by centroid on all three
-// axes, the bins are swept for the cheapest SAH split, and the references are partitioned in place.
+// axes (bvh_bins.h), the bins are swept for the cheapest SAH split, and the references are partitioned.
 //
 // Binning and partitioning are one pass per level, not two: while a node's references are partitioned,
 // each is binned into its child's bins on a grid inherited from the parent (the split axis cut at the
-// split plane, the other axes unchanged). A child whose centroids turn out to fill less than
-// kLooseGrid of that grid on some axis is binned again on its own grid before it is split, so the
-// inherited grid never costs more than a factor of 1/kLooseGrid in bin resolution.
+// split plane, the other axes unchanged). A child whose occupied bins span less than kLooseGrid of that
+// grid on some axis is binned again on its own grid before it is split, so the inherited grid never costs
+// more than a factor of 1/kLooseGrid in bin resolution. Small nodes take an exact split
+// (bvh_small_splits.h).
+//
+// Nodes up to kScratchRefs references are partitioned out of place, into a per-thread scratch of at most
+// 1/8 of the references (it stays in cache, and peak memory grows by a few bytes per primitive at most);
+// larger ones in place. The root's box and bins are computed in fixed chunks that idle threads help with
+// (merging chunks is exact, so the result does not depend on the thread count).
 //
 // Subtrees above kSpawnRefs become tasks that any thread may run; each task records its subtree as a
-// pre-order byte code (1 byte per node, no boxes), and the codes are expanded into the output in a fixed
-// order, so the tree is identical for every thread count. Boxes are recomputed from the references during
-// that expansion: the build never holds two copies of the tree (peak = references + tree + ids).
+// pre-order byte code (1 byte per node, no boxes), expanded into the output once, after the build
+// (bvh_code.h), so the tree is identical for every thread count.
 #include <emmintrin.h>
 
 #include <algorithm>
@@ -19,109 +24,27 @@
 #include <memory>
 #include <thread>
 
+#include "bvh_bins.h"
 #include "bvh_code.h"
+#include "bvh_small_splits.h"
 #include "bvh_task_queue.h"
 
 namespace asval::builder::detail {
 namespace {
 
 constexpr uint32_t kSpawnRefs = 4096;
-constexpr uint32_t kMaxBins = 64;
-constexpr uint32_t kSweepMax = 12;    // nodes this small get an exact SAH sweep instead of bins
-constexpr uint32_t kExhaustiveMax = 5;
-// Nodes up to this size are partitioned out of place, in a per-thread scratch of at most 1/8 of the
-// references (2 MiB at most: peak memory stays within a few bytes per primitive).
+constexpr float kLooseGrid = 0.5f;        // see the file comment
+constexpr uint32_t kSideSample = 32;      // references sampled to choose the partition loop
 constexpr uint32_t kScratchRefs = 1u << 16;
 constexpr uint32_t kScratchMinRefs = 1u << 10;
-constexpr uint32_t kSideSample = 32;  // references sampled to choose the partition loop  // nodes this small try every bipartition
-constexpr float kLooseGrid = 0.5f;    // see the file comment
-
-
-struct Bin {
-    __m128 lo, hi;
-};
-
-// Maps a reference's doubled centroid (lo + hi) to bin coordinates on the three axes at once:
-// t = (c * p - cmin * p) * q, clamped to [0, bins - 1]; the bin is trunc(t). p is a power of two keeping
-// tiny (subnormal) and huge extents in range; garbage lanes (NaN, inf) clamp and only cost quality.
-struct Grid {
-    __m128 p, cminp, q, maxBin;
-    alignas(16) float lo[4], hi[4];  // the centroid range the grid spans
-    alignas(16) float qs[4];         // q per axis; 0: the axis has no extent and is never split
-
-    __m128 Coord(__m128 c2) const {
-        const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);
-        return _mm_min_ps(_mm_max_ps(t, _mm_setzero_ps()), maxBin);  // NaN -> 0
-    }
-};
-
-Grid MakeGrid(const float lo[4], const float hi[4], uint32_t bins) {
-    Grid g;
-    alignas(16) float p[4] = {1, 1, 1, 1}, cminp[4] = {0, 0, 0, 0};
-    for (int a = 0; a < 4; ++a) { g.lo[a] = lo[a]; g.hi[a] = hi[a]; g.qs[a] = 0; }
-    for (int a = 0; a < 3; ++a) {
-        const double extent = double(hi[a]) - double(lo[a]);
-        if (!(extent > 0)) continue;
-        p[a] = extent < 1e-30 ? 0x1p100f : (extent > 1e37 ? 0x1p-4f : 1.0f);
-        g.qs[a] = float(double(bins) * (1 - 1e-6) / (extent * double(p[a])));
-        cminp[a] = lo[a] * p[a];
-    }
-    g.p = _mm_load_ps(p);
-    g.cminp = _mm_load_ps(cminp);
-    g.q = _mm_load_ps(g.qs);
-    g.maxBin = _mm_set1_ps(float(bins - 1));
-    return g;
-}
-
-// One node's bins: per axis, `bins` boxes and counts, on `grid`. `valid` is false until filled.
-struct BinSet {
-    Grid grid;
-    std::unique_ptr<Bin[]> box;  // [axis * bins + k]
-    std::unique_ptr<uint32_t[]> count;
-    bool valid = false;
-
-    explicit BinSet(uint32_t bins) : box(new Bin[3 * bins]), count(new uint32_t[3 * bins]) {}
-
-    void Reset(const Grid& g, uint32_t bins) {
-        grid = g;
-        for (uint32_t k = 0; k < 3 * bins; ++k) box[k] = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
-        std::fill(count.get(), count.get() + 3 * bins, 0u);
-        valid = true;
-    }
-    void Add(const PrimRef& ref, __m128 c2, uint32_t bins) {
-        const __m128i k = _mm_cvttps_epi32(grid.Coord(c2));
-        const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
-        const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
-        const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
-        const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
-        box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
-        box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
-        box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
-    }
-
-    // Byte image for handing the bins to a spawned task.
-    void SaveTo(std::vector<uint8_t>* out, uint32_t bins) const {
-        const size_t boxBytes = sizeof(Bin) * 3 * bins, countBytes = sizeof(uint32_t) * 3 * bins;
-        out->resize(sizeof(Grid) + boxBytes + countBytes);
-        std::memcpy(out->data(), &grid, sizeof(Grid));
-        std::memcpy(out->data() + sizeof(Grid), box.get(), boxBytes);
-        std::memcpy(out->data() + sizeof(Grid) + boxBytes, count.get(), countBytes);
-    }
-    void LoadFrom(const std::vector<uint8_t>& in, uint32_t bins) {
-        const size_t boxBytes = sizeof(Bin) * 3 * bins, countBytes = sizeof(uint32_t) * 3 * bins;
-        std::memcpy(&grid, in.data(), sizeof(Grid));
-        std::memcpy(box.get(), in.data() + sizeof(Grid), boxBytes);
-        std::memcpy(count.get(), in.data() + sizeof(Grid) + boxBytes, countBytes);
-        valid = true;
-    }
-};
+constexpr uint32_t kChunkRefs = 1u << 16;  // chunk of the parallel passes over large nodes
+constexpr uint32_t kChunkedMin = 4 * kChunkRefs;
 
 // Per-thread bin storage: the bins of the two children of the node at depth d live in slot (d + 1, side),
 // so a node's bins survive while its left subtree is built (which only uses deeper slots).
 class Workspace {
 public:
     explicit Workspace(uint32_t bins) : bins_(bins) {}
-    // Scratch for the out-of-place partition of nodes up to kScratchRefs references.
     PrimRef* Scratch(uint32_t count) {
         if (scratch_.size() < count) scratch_.resize(std::max<size_t>(count, 2 * scratch_.size()));
         return scratch_.data();
@@ -138,26 +61,6 @@ private:
     std::vector<PrimRef> scratch_;
 };
 
-// Running box + centroid box of one side of a split.
-struct Side {
-    __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-    __m128 clo = _mm_set1_ps(INFINITY), chi = _mm_set1_ps(-INFINITY);
-    void Add(const PrimRef& ref, __m128 c2) {
-        lo = _mm_min_ps(lo, LoadLo(ref));
-        hi = _mm_max_ps(hi, LoadHi(ref));
-        clo = MinKeep(clo, c2);
-        chi = MaxKeep(chi, c2);
-    }
-    void Add(const PrimRef& ref) { Add(ref, Centroid(ref)); }
-    Range ToRange(uint32_t b, uint32_t e, uint32_t depth) const { return Range{b, e, lo, hi, clo, chi, depth}; }
-};
-
-float Lane(__m128 v, int axis) {
-    alignas(16) float f[4];
-    _mm_store_ps(f, v);
-    return f[axis];
-}
-
 // A split chosen from a node's bins.
 struct BinSplit {
     int axis = -1;
@@ -165,6 +68,8 @@ struct BinSplit {
     uint32_t leftCount = 0;
     double cost = INFINITY;
 };
+
+uint32_t Chunks(uint32_t count) { return (count + kChunkRefs - 1) / kChunkRefs; }
 
 class BinnedBuilder {
 public:
@@ -174,6 +79,12 @@ public:
           scratchRefs_(std::clamp<uint32_t>(totalRefs / 8, kScratchMinRefs, kScratchRefs)), queue_(q) {}
 
     uint32_t Bins() const { return bins_; }
+
+    // The root's range is measured here rather than before the workers start, so they can help.
+    void RunRoot(Task* root, Workspace* ws) {
+        root->range = MeasureRange(root->range.begin, root->range.end, root->range.depth);
+        RunTask(root, ws);
+    }
 
     void RunTask(Task* task, Workspace* ws) {
         BinSet* bins = ws->Slot(task->range.depth, 0);
@@ -195,109 +106,17 @@ private:
 
     static void MakeLeaf(Task* task, const Range& r) { task->code.push_back(uint8_t(r.end - r.begin)); }
 
-    // Full SAH sweep for small nodes: sort by centroid on each axis, evaluate every split position.
-    // Returns false when no split exists (identical centroids on every axis).
-    bool SweepSmall(const Range& r, double* bestCost, Range* left, Range* right) {
-        constexpr uint32_t kMax = kSweepMax;
-        const uint32_t count = r.end - r.begin;
-        if (count <= kExhaustiveMax) return BestSubsetSplit(r, bestCost, left, right);
-        const PrimRef* const refs = refs_ + r.begin;
-        alignas(16) float centroid[kMax][4];
-        for (uint32_t i = 0; i < count; ++i) _mm_store_ps(centroid[i], Centroid(refs[i]));
-        struct Entry { float key; uint32_t index; };
-        Entry order[3][kMax];
-        double rightArea[kMax];
-        int bestAxis = -1;
-        uint32_t bestSplit = 0;
-        *bestCost = INFINITY;
-        for (int a = 0; a < 3; ++a) {
-            if (!(Lane(r.chi, a) > Lane(r.clo, a))) continue;
-            Entry* o = order[a];
-            for (uint32_t i = 0; i < count; ++i) {
-                // Insertion sort; ties by position keep it deterministic.
-                const Entry e{centroid[i][a], i};
-                uint32_t k = i;
-                while (k > 0 && o[k - 1].key > e.key) { o[k] = o[k - 1]; --k; }
-                o[k] = e;
-            }
-            __m128 lo = _mm_set1_ps(INFINITY), hi = _mm_set1_ps(-INFINITY);
-            for (uint32_t k = count - 1; k > 0; --k) {
-                lo = _mm_min_ps(lo, LoadLo(refs[o[k].index]));
-                hi = _mm_max_ps(hi, LoadHi(refs[o[k].index]));
-                rightArea[k] = HalfArea(lo, hi);
-            }
-            lo = _mm_set1_ps(INFINITY); hi = _mm_set1_ps(-INFINITY);
-            for (uint32_t k = 0; k + 1 < count; ++k) {
-                lo = _mm_min_ps(lo, LoadLo(refs[o[k].index]));
-                hi = _mm_max_ps(hi, LoadHi(refs[o[k].index]));
-                const double cost = HalfArea(lo, hi) * (k + 1) + rightArea[k + 1] * (count - k - 1);
-                if (cost < *bestCost) { *bestCost = cost; bestAxis = a; bestSplit = k + 1; }
-            }
-        }
-        if (bestAxis < 0) return false;
-        PrimRef sorted[kMax];
-        for (uint32_t k = 0; k < count; ++k) sorted[k] = refs[order[bestAxis][k].index];
-        Side l, rr;
-        for (uint32_t k = 0; k < count; ++k) {
-            refs_[r.begin + k] = sorted[k];
-            (k < bestSplit ? l : rr).Add(sorted[k]);
-        }
-        *left = l.ToRange(r.begin, r.begin + bestSplit, r.depth + 1);
-        *right = rr.ToRange(r.begin + bestSplit, r.end, r.depth + 1);
-        return true;
-    }
-
-    // Bits set in a mask below 2^kExhaustiveMax (the portable builtin becomes a library call without
-    // -mpopcnt, which this library does not assume).
-    static uint32_t PopCount5(uint32_t m) {
-        static_assert(kExhaustiveMax <= 5, "table size");
-        static constexpr uint8_t kBits[32] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,
-                                              1, 2, 2, 3, 2, 3, 3, 4, 2, 3, 3, 4, 3, 4, 4, 5};
-        return kBits[m];
-    }
-
-    // Exact best split of a tiny node over every bipartition (a superset of the sweep's candidates):
-    // the boxes of all 2^n subsets are built incrementally, each from a smaller one.
-    bool BestSubsetSplit(const Range& r, double* bestCost, Range* left, Range* right) {
-        const uint32_t count = r.end - r.begin;
-        PrimRef* const refs = refs_ + r.begin;
-        const uint32_t full = (1u << count) - 1;
-        __m128 lo[1u << kExhaustiveMax], hi[1u << kExhaustiveMax];
-        double area[1u << kExhaustiveMax];
-        lo[0] = _mm_set1_ps(INFINITY);
-        hi[0] = _mm_set1_ps(-INFINITY);
-        for (uint32_t m = 1; m <= full; ++m) {
-            const uint32_t low = uint32_t(__builtin_ctz(m)), rest = m & (m - 1);
-            lo[m] = _mm_min_ps(lo[rest], LoadLo(refs[low]));
-            hi[m] = _mm_max_ps(hi[rest], LoadHi(refs[low]));
-            area[m] = HalfArea(lo[m], hi[m]);
-        }
-        // Element 0 always on the left: each bipartition once.
-        uint32_t best = 0;
-        *bestCost = INFINITY;
-        for (uint32_t m = 1; m < full; m += 2) {
-            const uint32_t n = PopCount5(m);
-            const double cost = area[m] * n + area[full ^ m] * (count - n);
-            if (cost < *bestCost) { *bestCost = cost; best = m; }
-        }
-        if (best == 0) return false;
-        PrimRef sorted[kExhaustiveMax];
-        uint32_t nl = 0, nr = PopCount5(best);
-        const uint32_t split = nr;
-        for (uint32_t i = 0; i < count; ++i) sorted[(best >> i) & 1 ? nl++ : nr++] = refs[i];
-        std::copy(sorted, sorted + count, refs);
-        *left = Range{r.begin, r.begin + split, lo[best], hi[best], _mm_setzero_ps(), _mm_setzero_ps(), r.depth + 1};
-        *right = Range{r.begin + split, r.end, lo[full ^ best], hi[full ^ best], _mm_setzero_ps(), _mm_setzero_ps(), r.depth + 1};
-        CentroidBounds(left);
-        CentroidBounds(right);
-        return true;
-    }
-
-    void CentroidBounds(Range* r) const {
-        Side s;
-        for (uint32_t i = r->begin; i < r->end; ++i) s.Add(refs_[i]);
-        r->clo = s.clo;
-        r->chi = s.chi;
+    // Exact box and centroid box of refs[begin, end), in chunks for large ranges.
+    Range MeasureRange(uint32_t begin, uint32_t end, uint32_t depth) {
+        const uint32_t chunks = Chunks(end - begin);
+        std::vector<Side> sides(chunks);
+        queue_->ParallelFor(chunks, [&](uint32_t c) {
+            const uint32_t b = begin + c * kChunkRefs, e = std::min(end, b + kChunkRefs);
+            for (uint32_t i = b; i < e; ++i) sides[c].Add(refs_[i]);
+        });
+        Side all;
+        for (const Side& s : sides) all.Merge(s);
+        return all.ToRange(begin, end, depth);
     }
 
     // Bins a node's references on its own grid (the root, and children whose inherited grid was loose).
@@ -306,7 +125,19 @@ private:
         _mm_store_ps(clo, r.clo);
         _mm_store_ps(chi, r.chi);
         bins->Reset(MakeGrid(clo, chi, bins_), bins_);
-        for (uint32_t i = r.begin; i < r.end; ++i) bins->Add(refs_[i], Centroid(refs_[i]), bins_);
+        const uint32_t count = r.end - r.begin;
+        if (count < kChunkedMin) {
+            for (uint32_t i = r.begin; i < r.end; ++i) bins->Add(refs_[i], Centroid(refs_[i]), bins_);
+            return;
+        }
+        std::vector<std::unique_ptr<BinSet>> parts(Chunks(count));
+        queue_->ParallelFor(uint32_t(parts.size()), [&](uint32_t c) {
+            parts[c] = std::make_unique<BinSet>(bins_);
+            parts[c]->Reset(bins->grid, bins_);
+            const uint32_t b = r.begin + c * kChunkRefs, e = std::min(r.end, b + kChunkRefs);
+            for (uint32_t i = b; i < e; ++i) parts[c]->Add(refs_[i], Centroid(refs_[i]), bins_);
+        });
+        for (const auto& p : parts) bins->Merge(*p, bins_);
     }
 
     // The cheapest split between bins; axis -1 when none exists.
@@ -392,20 +223,25 @@ private:
                          BinSet* leftBins, BinSet* rightBins, Workspace* ws) {
         leftBins->Reset(ChildGrid(bins.grid, s, true), bins_);
         rightBins->Reset(ChildGrid(bins.grid, s, false), bins_);
+        const uint32_t count = r.end - r.begin;
         uint32_t mid;
-        if (r.end - r.begin <= scratchRefs_) {
-            PrimRef* scratch = ws->Scratch(r.end - r.begin);
+        if (count <= scratchRefs_) {
             // Both loops give the same result; which is faster depends on how often the side changes
             // from one reference to the next (coherent meshes: rarely, and a branch predicts well).
             const bool masked = SideChangesOften(r, bins.grid, s);
+            PrimRef* const refs = refs_ + r.begin;
+            PrimRef* const scratch = ws->Scratch(count);
+            uint32_t l;
             switch (s.axis * 2 + int(masked)) {
-                case 0: mid = PartitionCopy<0, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                case 1: mid = PartitionCopy<0, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                case 2: mid = PartitionCopy<1, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                case 3: mid = PartitionCopy<1, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                case 4: mid = PartitionCopy<2, false>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
-                default: mid = PartitionCopy<2, true>(r, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 0: l = PartitionCopy<0, false>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 1: l = PartitionCopy<0, true>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 2: l = PartitionCopy<1, false>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 3: l = PartitionCopy<1, true>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                case 4: l = PartitionCopy<2, false>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
+                default: l = PartitionCopy<2, true>(refs, count, bins.grid, s.bin, leftBins, rightBins, scratch); break;
             }
+            std::memcpy(static_cast<void*>(refs), scratch, sizeof(PrimRef) * count);
+            mid = r.begin + l;
         } else {
             switch (s.axis) {
                 case 0: mid = PartitionLoop<0>(r, bins.grid, s.bin, leftBins, rightBins); break;
@@ -426,19 +262,20 @@ private:
         const __m128 splitAt = _mm_set1_ps(float(s.bin));
         uint32_t changes = 0, previous = 2;
         for (uint32_t i = 0; i < n; ++i) {
-            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(Centroid(refs_[r.begin + i]), g.p), g.cminp), g.q);
-            const uint32_t left = uint32_t(_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) >> s.axis) & 1u;
+            const uint32_t left = g.Left(Centroid(refs_[r.begin + i]), splitAt, s.axis);
             changes += uint32_t(previous != 2 && left != previous);
             previous = left;
         }
         return changes * 4 > n;
     }
 
-    // Branch-free out-of-place partition: each reference is written to both ends of the scratch and
-    // the side it belongs to advances, so the unpredictable side decision never becomes a branch.
+    // Out-of-place partition of refs[0, count) into scratch (left side forward from 0, right side
+    // backward from count), binning each reference into its side's bins. Each reference is written to
+    // both ends and only its side's cursor advances, so the side decision never becomes a branch there;
+    // kMasked also selects the bins by mask (for nodes whose side flips often). Returns the left count.
     template <int kAxis, bool kMasked>
-    uint32_t PartitionCopy(const Range& r, const Grid& node, uint32_t splitBin, BinSet* leftBins,
-                           BinSet* rightBins, PrimRef* scratch) {
+    uint32_t PartitionCopy(const PrimRef* refs, uint32_t count, const Grid& node, uint32_t splitBin,
+                           BinSet* leftBins, BinSet* rightBins, PrimRef* scratch) const {
         const Grid gl = leftBins->grid, gr = rightBins->grid;
         Bin* const lbox = leftBins->box.get();
         Bin* const rbox = rightBins->box.get();
@@ -446,8 +283,6 @@ private:
         uint32_t* const rcount = rightBins->count.get();
         const __m128 p = node.p, cminp = node.cminp, q = node.q, splitAt = _mm_set1_ps(float(splitBin));
         const uint32_t bins = bins_;
-        PrimRef* const refs = refs_ + r.begin;
-        const uint32_t count = r.end - r.begin;
         const uintptr_t rboxBits = reinterpret_cast<uintptr_t>(rbox), rcountBits = reinterpret_cast<uintptr_t>(rcount);
         const uintptr_t boxDiff = reinterpret_cast<uintptr_t>(lbox) ^ rboxBits;
         const uintptr_t countDiff = reinterpret_cast<uintptr_t>(lcount) ^ rcountBits;
@@ -455,7 +290,7 @@ private:
         for (uint32_t i = 0; i < count; ++i) {
             const __m128 lo = LoadLo(refs[i]), hi = LoadHi(refs[i]);
             const __m128 c2 = _mm_add_ps(lo, hi);
-            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);
+            const __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(c2, p), cminp), q);  // Grid::Left, inlined
             const uint32_t left = uint32_t(_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) >> kAxis) & 1u;
             _mm_store_ps(scratch[l].lo, lo);
             _mm_store_ps(scratch[l].hi, hi);
@@ -487,10 +322,10 @@ private:
             box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++cnt[k1];
             box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++cnt[k2];
         }
-        std::memcpy(static_cast<void*>(refs), scratch, sizeof(PrimRef) * count);
-        return r.begin + l;
+        return l;
     }
 
+    // In-place two-pointer partition (nodes above the scratch size: the top few levels).
     // Kept small so that the three grids stay in registers: no running boxes here (they come from bins).
     template <int kAxis>
     uint32_t PartitionLoop(const Range& r, const Grid& node, uint32_t splitBin, BinSet* leftBins, BinSet* rightBins) {
@@ -553,7 +388,7 @@ private:
         bool found = false;
         if (!forceMedian) {
             if (count <= kSweepMax) {
-                found = SweepSmall(r, &cost, &left, &right);
+                found = SmallNodeSplit(refs_, r, &cost, &left, &right);
             } else {
                 if (!bins->valid) BinOwnGrid(r, bins);
                 const BinSplit s = BestBinSplit(*bins);
@@ -580,10 +415,8 @@ private:
                     return cx < cy || (cx == cy && x.id < y.id);
                 });
             }
-            Side l, rr;
-            for (uint32_t i = r.begin; i < r.end; ++i) (i < mid ? l : rr).Add(refs_[i]);
-            left = l.ToRange(r.begin, mid, r.depth + 1);
-            right = rr.ToRange(mid, r.end, r.depth + 1);
+            left = RangeFromRefs(r.begin, mid, r.depth + 1);
+            right = RangeFromRefs(mid, r.end, r.depth + 1);
         }
 
         if (right.end - right.begin >= kSpawnRefs) {
@@ -609,27 +442,30 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
     Bvh bvh;
     if (refs.empty()) return bvh;
     TaskQueue queue;
-    BinnedBuilder builder(refs.data(), uint32_t(refs.size()), options, &queue);
-    Task root;
     {
-        Side all;
-        for (const PrimRef& ref : refs) all.Add(ref);
-        root.range = all.ToRange(0, uint32_t(refs.size()), 1);
-    }
-    queue.Push(&root);
-    auto work = [&builder, &queue] {
-        Workspace ws(builder.Bins());
-        queue.Work([&](Task* t) { builder.RunTask(t, &ws); });
-    };
-    std::vector<std::thread> workers;
-    for (uint32_t i = 1; i < std::max<uint32_t>(options.threads, 1); ++i) workers.emplace_back(work);
-    work();
-    for (auto& w : workers) w.join();
+        BinnedBuilder builder(refs.data(), uint32_t(refs.size()), options, &queue);
+        Task root;
+        root.range.begin = 0;
+        root.range.end = uint32_t(refs.size());
+        root.range.depth = 1;
+        queue.Push(&root);
+        auto work = [&builder, &queue, &root] {
+            Workspace ws(builder.Bins());
+            queue.Work([&](Task* t) {
+                if (t == &root) builder.RunRoot(t, &ws);
+                else builder.RunTask(t, &ws);
+            });
+        };
+        std::vector<std::thread> workers;
+        for (uint32_t i = 1; i < std::max<uint32_t>(options.threads, 1); ++i) workers.emplace_back(work);
+        work();
+        for (auto& w : workers) w.join();
 
-    // Expand the codes (boxes and ids come from the references, released as they are read), then free them.
-    bvh.nodes.resize(CountNodes(root));
-    bvh.primIds.resize(refs.size());
-    ExpandCodes(refs.data(), refs.size(), root, bvh.nodes.data(), bvh.primIds.data(), &bvh.stats);
+        // Expand the codes (boxes and ids come from the references, released as they are read), then free them.
+        bvh.nodes.resize(CountNodes(root));
+        bvh.primIds.resize(refs.size());
+        ExpandCodes(refs.data(), refs.size(), root, bvh.nodes.data(), bvh.primIds.data(), &bvh.stats);
+    }
     std::vector<PrimRef>().swap(refs);
     return bvh;
 }
