@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
     for (int i = 2; i < argc; ++i) names.push_back(argv[i]);
     if (names.empty()) names = {"uniform", "sphere", "terrain", "clustered"};
     const int reps = n >= 1000000 ? 3 : 5;
-    std::printf("scene,builder,knobs,threads,seconds,mprims,sah,ratio,peak_bpp,cpu_seconds,peak_rss_bpp\n");
+    std::printf("scene,builder,knobs,threads,seconds,mprims,sah,ratio,peak_bpp,cpu_seconds\n");
     for (const std::string& name : names) {
         const scenes::Scene& s = bench::CachedScene(name, n);
         double anchorSah = 0;
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
                     const anchor::Result r = anchor::UserBvh(s, q, threads);
                     if (q == 2) anchorSah = r.sah;
                     const char* label = q == 0 ? "embree_user_LOW" : q == 1 ? "embree_user_MEDIUM" : "embree_user_HIGH";
-                    std::printf("%s,%s,leaf8,%d,%.6f,%.3f,%.4f,%s,0,0,0\n", name.c_str(), label, threads, r.seconds,
+                    std::printf("%s,%s,leaf8,%d,%.6f,%.3f,%.4f,%s,0,0\n", name.c_str(), label, threads, r.seconds,
                                 s.triangles / r.seconds * 1e-6, r.sah, "nan");
                     std::fflush(stdout);
                 }
@@ -50,15 +50,15 @@ int main(int argc, char** argv) {
             for (int q = 0; q <= 1; ++q)
                 for (int threads : {1, 2}) {
                     const double sec = anchor::SceneCommit(s, q, threads);
-                    std::printf("%s,%s,bvh8,%d,%.6f,%.3f,0,0,0,0,0\n", name.c_str(), q == 0 ? "embree_commit_LOW" : "embree_commit_MEDIUM",
+                    std::printf("%s,%s,bvh8,%d,%.6f,%.3f,0,0,0,0\n", name.c_str(), q == 0 ? "embree_commit_LOW" : "embree_commit_MEDIUM",
                                 threads, sec, s.triangles / sec * 1e-6);
                 }
         }
         auto row = [&](const char* builder, const std::string& knobs, const BuildOptions& o) {
             const bench::BuildRun r = Measure(s, o, reps);
-            std::printf("%s,%s,%s,%u,%.6f,%.3f,%.4f,%.4f,%.1f,%.6f,%.1f\n", name.c_str(), builder, knobs.c_str(), o.threads,
+            std::printf("%s,%s,%s,%u,%.6f,%.3f,%.4f,%.4f,%.1f,%.6f\n", name.c_str(), builder, knobs.c_str(), o.threads,
                         r.seconds, s.triangles / r.seconds * 1e-6, r.sah, anchorSah > 0 ? r.sah / anchorSah : 0.0,
-                        double(r.peakBytes) / s.triangles, r.cpuSeconds, double(r.peakResidentBytes) / s.triangles);
+                        double(r.peakBytes) / s.triangles, r.cpuSeconds);
             std::fflush(stdout);
         };
         for (uint32_t threads : {1u, 2u}) {

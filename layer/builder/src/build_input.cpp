@@ -53,6 +53,22 @@ void VertexInterval(const VertexFormatInfo& info, const uint8_t* p, float lo[3],
     }
 }
 
+// Widens [lo, hi] by one vertex's exact interval, through the transform when there is one.
+void AddVertex(const VertexFormatInfo& info, const uint8_t* p, const float* transform, float lo[3], float hi[3]) {
+    float vlo[3], vhi[3];
+    VertexInterval(info, p, vlo, vhi);
+    if (transform) {
+        float tlo[3], thi[3];
+        TransformBoxConservative(transform, vlo, vhi, tlo, thi);
+        std::memcpy(vlo, tlo, sizeof vlo);
+        std::memcpy(vhi, thi, sizeof vhi);
+    }
+    for (int c = 0; c < 3; ++c) {
+        lo[c] = vlo[c] < lo[c] ? vlo[c] : lo[c];
+        hi[c] = vhi[c] > hi[c] ? vhi[c] : hi[c];
+    }
+}
+
 void Put(BuildInput* out, uint32_t id, const float lo[3], const float hi[3]) {
     PrimRef r;
     bool infinite = false;
@@ -123,20 +139,7 @@ void AppendMotionTriangles(const TriangleGeometryView& view, bool allowUpdate, u
         float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int k = 0; k < 3; ++k) {
             const uint64_t off = detail::MotionVertexOffset(view, indexBytes, t, k);  // readable at both times
-            for (const uint8_t* vb : buffers) {
-                float vlo[3], vhi[3];
-                VertexInterval(info, vb + off, vlo, vhi);
-                if (transformed) {
-                    float tlo[3], thi[3];
-                    TransformBoxConservative(m, vlo, vhi, tlo, thi);
-                    std::memcpy(vlo, tlo, sizeof vlo);
-                    std::memcpy(vhi, thi, sizeof vhi);
-                }
-                for (int c = 0; c < 3; ++c) {
-                    lo[c] = vlo[c] < lo[c] ? vlo[c] : lo[c];
-                    hi[c] = vhi[c] > hi[c] ? vhi[c] : hi[c];
-                }
-            }
+            for (const uint8_t* vb : buffers) AddVertex(info, vb + off, transformed ? m : nullptr, lo, hi);
         }
         Put(out, idBase + t, lo, hi);
     }
@@ -196,18 +199,7 @@ void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_
                 const uint64_t idx = indexBytes == 1 ? ip[0] : indexBytes == 2 ? detail::LoadU16(ip) : detail::LoadU32(ip);
                 off = (idx + view.range.firstVertex) * view.vertexStride;  // readable: the classifier checked
             }
-            float vlo[3], vhi[3];
-            VertexInterval(info, vb + off, vlo, vhi);
-            if (transformed) {
-                float tlo[3], thi[3];
-                TransformBoxConservative(m, vlo, vhi, tlo, thi);
-                std::memcpy(vlo, tlo, sizeof vlo);
-                std::memcpy(vhi, thi, sizeof vhi);
-            }
-            for (int c = 0; c < 3; ++c) {
-                lo[c] = vlo[c] < lo[c] ? vlo[c] : lo[c];
-                hi[c] = vhi[c] > hi[c] ? vhi[c] : hi[c];
-            }
+            AddVertex(info, vb + off, transformed ? m : nullptr, lo, hi);
         }
         Put(out, idBase + t, lo, hi);
     }

@@ -315,12 +315,7 @@ private:
                 box = rbox;
                 cnt = rcount;
             }
-            const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
-            const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
-            const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
-            box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++cnt[k0];
-            box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++cnt[k1];
-            box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++cnt[k2];
+            AddToBins(box, cnt, k, lo, hi, bins);
         }
         return l;
     }
@@ -343,14 +338,7 @@ private:
             return (_mm_movemask_ps(_mm_cmpnge_ps(t, splitAt)) & (1 << kAxis)) != 0;
         };
         auto add = [bins](const Grid& g, Bin* box, uint32_t* count, const PrimRef& ref, __m128 c2) {
-            const __m128i k = _mm_cvttps_epi32(g.Coord(c2));
-            const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
-            const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
-            const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
-            const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
-            box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
-            box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
-            box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
+            AddToBins(box, count, _mm_cvttps_epi32(g.Coord(c2)), LoadLo(ref), LoadHi(ref), bins);
         };
         PrimRef* const refs = refs_;
         uint32_t i = r.begin, j = r.end;

@@ -58,6 +58,16 @@ inline Grid MakeGrid(const float lo[4], const float hi[4], uint32_t bins) {
     return g;
 }
 
+// Adds a reference (box lo/hi) to its bin on each axis; k holds the three bin indices.
+inline void AddToBins(Bin* box, uint32_t* count, __m128i k, __m128 lo, __m128 hi, uint32_t bins) {
+    const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
+    const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
+    const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
+    box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
+    box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
+    box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
+}
+
 // One node's bins: per axis, `bins` boxes and counts, on `grid`. `valid` is false until filled.
 struct BinSet {
     Grid grid;
@@ -74,14 +84,7 @@ struct BinSet {
         valid = true;
     }
     void Add(const PrimRef& ref, __m128 c2, uint32_t bins) {
-        const __m128i k = _mm_cvttps_epi32(grid.Coord(c2));
-        const uint32_t k0 = uint32_t(_mm_cvtsi128_si32(k));
-        const uint32_t k1 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1))) + bins;
-        const uint32_t k2 = uint32_t(_mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2))) + 2 * bins;
-        const __m128 lo = LoadLo(ref), hi = LoadHi(ref);
-        box[k0].lo = _mm_min_ps(box[k0].lo, lo); box[k0].hi = _mm_max_ps(box[k0].hi, hi); ++count[k0];
-        box[k1].lo = _mm_min_ps(box[k1].lo, lo); box[k1].hi = _mm_max_ps(box[k1].hi, hi); ++count[k1];
-        box[k2].lo = _mm_min_ps(box[k2].lo, lo); box[k2].hi = _mm_max_ps(box[k2].hi, hi); ++count[k2];
+        AddToBins(box.get(), count.get(), _mm_cvttps_epi32(grid.Coord(c2)), LoadLo(ref), LoadHi(ref), bins);
     }
     // Adds another set on the same grid (min / max / + are exact: the result does not depend on how the
     // references were split between the sets).
