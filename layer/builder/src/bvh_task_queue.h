@@ -34,7 +34,7 @@ public:
                 l.unlock();
                 RunItems(*b);
                 l.lock();
-                if (--b->helpers == 0) cv_.notify_all();
+                if (--b->helpers == 0) batchDone_.notify_all();
             } else if (!queue_.empty()) {
                 Task* t = queue_.front();
                 queue_.pop_front();
@@ -61,7 +61,7 @@ public:
         RunItems(b);
         std::unique_lock<std::mutex> l(mutex_);
         batches_.erase(std::find(batches_.begin(), batches_.end(), &b));
-        cv_.wait(l, [&b] { return b.helpers == 0; });  // every item taken has finished
+        batchDone_.wait(l, [&b] { return b.helpers == 0; });  // every item taken has finished
     }
 
 private:
@@ -84,7 +84,8 @@ private:
     }
 
     std::mutex mutex_;
-    std::condition_variable cv_;
+    std::condition_variable cv_;          // idle workers: a task or a batch item is available, or all done
+    std::condition_variable batchDone_;   // batch owners: their batch's helpers have finished
     std::deque<Task*> queue_;
     std::vector<Batch*> batches_;
     uint32_t pending_ = 0;

@@ -34,8 +34,10 @@ public:
 #if defined(__linux__) && defined(MADV_DONTNEED)
         const uintptr_t from = (released_ + page_ - 1) & ~(page_ - 1);
         const uintptr_t to = (begin_ + consumedBytes) & ~(page_ - 1);
-        if (to > from && to <= end_) (void)madvise(reinterpret_cast<void*>(from), to - from, MADV_DONTNEED);
-        released_ = begin_ + consumedBytes;
+        if (to > from && to <= end_) {
+            (void)madvise(reinterpret_cast<void*>(from), to - from, MADV_DONTNEED);
+            released_ = to;  // the partly read page after `to` is released next time
+        }
 #endif
     }
 
