@@ -4,9 +4,10 @@
 // Binning and partitioning are one pass per level, not two: while a node's references are partitioned,
 // each is binned into its child's bins on a grid inherited from the parent (the split axis cut at the
 // split plane, the other axes unchanged). A child whose occupied bins span less than kLooseGrid of that
-// grid on some axis is binned again on its own grid before it is split, so the inherited grid never costs
-// more than a factor of 1/kLooseGrid in bin resolution. Small nodes take an exact split
-// (bvh_small_splits.h).
+// grid on some axis (with 16 bins: all its centroids in one bin) is binned again on its own grid before it
+// is split, so no axis is left without a split candidate. Re-binning more eagerly (at a span below half
+// the grid) bought 0.04-0.1% SAH on the mesh scenes for 10-15% of the build time. Small nodes take an
+// exact split (bvh_small_splits.h).
 //
 // Nodes up to kScratchRefs references are partitioned out of place, into a per-thread scratch of at most
 // 1/8 of the references (it stays in cache, and peak memory grows by a few bytes per primitive at most);
@@ -33,7 +34,7 @@ namespace asval::builder::detail {
 namespace {
 
 constexpr uint32_t kSpawnRefs = 4096;
-constexpr float kLooseGrid = 0.5f;        // see the file comment
+constexpr float kLooseGrid = 0.125f;     // see the file comment
 constexpr uint32_t kSideSample = 32;      // references sampled to choose the partition loop
 constexpr uint32_t kScratchRefs = 1u << 16;
 constexpr uint32_t kScratchMinRefs = 1u << 10;
