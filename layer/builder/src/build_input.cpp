@@ -13,6 +13,7 @@
 #include "format_traits.h"
 #include "motion_instances.h"
 #include "motion_triangles.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 namespace {
@@ -59,7 +60,7 @@ void AddVertex(const VertexFormatInfo& info, const uint8_t* p, const float* tran
     VertexInterval(info, p, vlo, vhi);
     if (transform) {
         float tlo[3], thi[3];
-        TransformBoxConservative(transform, vlo, vhi, tlo, thi);
+        detail::TransformBox(transform, vlo, vhi, tlo, thi);
         std::memcpy(vlo, tlo, sizeof vlo);
         std::memcpy(vhi, thi, sizeof vhi);
     }
@@ -148,6 +149,7 @@ void AppendMotionTriangles(const TriangleGeometryView& view, bool allowUpdate, u
 }  // namespace
 
 void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    const detail::FloatModeGuard mode;
     if (view.motionVertexData) { AppendMotionTriangles(view, allowUpdate, idBase, out); return; }
     const uint32_t n = view.range.primitiveCount;
     std::vector<uint8_t> states(n);
@@ -206,6 +208,7 @@ void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_
 }
 
 void AppendAabbs(const AabbGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    const detail::FloatModeGuard mode;
     const uint32_t n = view.range.primitiveCount;
     std::vector<uint8_t> states(n);
     ClassifyAabbs(view, nullptr, states.data());
@@ -248,6 +251,7 @@ void AppendMotionInstances(const InstanceGeometryView& view, BlasLookup lookup, 
 
 void AppendInstances(const InstanceGeometryView& view, BlasLookup lookup, void* user, uint32_t idBase,
                      BuildInput* out) {
+    const detail::FloatModeGuard mode;
     if (view.motionInstances) { AppendMotionInstances(view, lookup, user, idBase, out); return; }
     const uint32_t n = view.range.primitiveCount;
     std::vector<uint8_t> states(n);
@@ -278,7 +282,7 @@ void AppendInstances(const InstanceGeometryView& view, BlasLookup lookup, void* 
             }
             ++out->degenerateInstances;
         } else {
-            TransformBoxConservative(m, blas.lo, blas.hi, lo, hi);
+            detail::TransformBox(m, blas.lo, blas.hi, lo, hi);
         }
         Put(out, idBase + i, lo, hi);
     }

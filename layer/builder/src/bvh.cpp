@@ -3,10 +3,12 @@
 #include <utility>
 
 #include "bvh_internal.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 
 Bvh BuildBvh(BuildInput&& input, const BuildOptions& options) {
+    const detail::FloatModeGuard mode;
     std::vector<PrimRef> refs = std::move(input.refs);
     Bvh bvh = options.mode == BuildMode::Lbvh ? detail::BuildLbvh(refs, options)
                                               : detail::BuildBinnedSah(refs, options);
@@ -15,6 +17,7 @@ Bvh BuildBvh(BuildInput&& input, const BuildOptions& options) {
 }
 
 double SahCost(const Bvh& bvh) {
+    const detail::FloatModeGuard mode;
     if (bvh.nodes.empty()) return 0.0;
     auto area = [](const BvhNode& n) { return detail::HalfArea(_mm_loadu_ps(n.lo), _mm_loadu_ps(n.hi)); };
     double sum = 0.0;

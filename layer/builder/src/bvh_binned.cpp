@@ -29,6 +29,7 @@
 #include "bvh_code.h"
 #include "bvh_small_splits.h"
 #include "bvh_task_queue.h"
+#include "float_mode.h"
 
 namespace asval::builder::detail {
 namespace {
@@ -439,6 +440,7 @@ Bvh BuildBinnedSah(std::vector<PrimRef>& refs, const BuildOptions& options) {
         root.range.depth = 1;
         queue.Push(&root);
         auto work = [&builder, &queue, &root] {
+            const FloatModeGuard mode;  // a new thread's mode is not the caller's guarded one everywhere
             Workspace ws(builder.Bins());
             queue.Work([&](Task* t) {
                 if (t == &root) builder.RunRoot(t, &ws);

@@ -2,6 +2,7 @@
 #include "asval/builder/classify.h"
 #include "format_traits.h"
 #include "motion_instances.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 namespace {
@@ -79,6 +80,7 @@ ClassifyResult ClassifyMotionInstances(const InstanceGeometryView& view, Activit
 }  // namespace
 
 ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    const detail::FloatModeGuard mode;
     ClassifyResult r;
     const uint32_t n = view.range.primitiveCount;
     r.primitiveCount = n;
@@ -126,6 +128,7 @@ ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* recor
 }
 
 ClassifyResult ClassifyInstances(const InstanceGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    const detail::FloatModeGuard mode;
     if (view.motionInstances) return ClassifyMotionInstances(view, record, states);
     ClassifyResult r;
     const uint32_t n = view.range.primitiveCount;

@@ -12,6 +12,7 @@
 #include "asval/builder/vertex_format.h"
 #include "format_traits.h"
 #include "motion_triangles.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 namespace {
@@ -336,6 +337,7 @@ uint64_t ReadableElements(uint64_t bytes, uint64_t offset, uint64_t elementBytes
 }  // namespace
 
 ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states) {
+    const detail::FloatModeGuard mode;
     if (view.motionVertexData) return detail::ClassifyMotionTriangles(view, record, states);  // motion_triangles.cpp
     ClassifyResult r;
     const uint32_t n = view.range.primitiveCount;

@@ -5,6 +5,7 @@
 
 #include "asval/builder/build_input.h"
 #include "conservative_bounds.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 namespace detail {
@@ -57,11 +58,16 @@ void RowInterval(const float row[4], const float lo[3], const float hi[3], float
     *outHi = RoundUp(exactHi ? sHi : sHi + margin);
 }
 
+void TransformBox(const float m[12], const float lo[3], const float hi[3], float outLo[3], float outHi[3]) {
+    for (int r = 0; r < 3; ++r) RowInterval(m + 4 * r, lo, hi, &outLo[r], &outHi[r]);
+}
+
 }  // namespace detail
 
 void TransformBoxConservative(const float m[12], const float lo[3], const float hi[3], float outLo[3],
                               float outHi[3]) {
-    for (int r = 0; r < 3; ++r) detail::RowInterval(m + 4 * r, lo, hi, &outLo[r], &outHi[r]);
+    const detail::FloatModeGuard mode;
+    detail::TransformBox(m, lo, hi, outLo, outHi);
 }
 
 }  // namespace asval::builder

@@ -65,8 +65,8 @@ void MatrixBox(const uint8_t* body, const float bLo[3], const float bHi[3], bool
         PointBox(t0, lo0, hi0);
         PointBox(t1, lo1, hi1);
     } else {
-        TransformBoxConservative(m0, bLo, bHi, lo0, hi0);
-        TransformBoxConservative(m1, bLo, bHi, lo1, hi1);
+        detail::TransformBox(m0, bLo, bHi, lo0, hi0);
+        detail::TransformBox(m1, bLo, bHi, lo1, hi1);
     }
     Hull(lo0, hi0, lo1, hi1, lo, hi);
 }
@@ -105,7 +105,7 @@ void SrtBox(const uint8_t* body, const float bLo[3], const float bHi[3], bool de
         const float* d = srt[e];  // sx a b pvx sy c pvy sz pvz qx qy qz qw tx ty tz
         const float s[12] = {d[0], d[1], d[2], d[3], 0, d[4], d[5], d[6], 0, 0, d[7], d[8]};
         float l[3], h[3];
-        TransformBoxConservative(s, boxLo, boxHi, l, h);
+        detail::TransformBox(s, boxLo, boxHi, l, h);
         if (e == 0) { std::memcpy(uLo, l, sizeof l); std::memcpy(uHi, h, sizeof h); }
         else Hull(uLo, uHi, l, h, uLo, uHi);
         const double qn = Up(SumSquaresUp(d[9], d[10], d[11]) + double(d[12]) * d[12]);
@@ -172,7 +172,7 @@ void MotionInstanceBox(const MotionRecord& rec, const float blasLo[3], const flo
                 const float t[3] = {m[3], m[7], m[11]};
                 PointBox(t, lo, hi);
             } else {
-                TransformBoxConservative(m, blasLo, blasHi, lo, hi);
+                detail::TransformBox(m, blasLo, blasHi, lo, hi);
             }
             return;
         }

@@ -12,6 +12,7 @@
 #include "lbvh_hugepages.h"
 #include "presplit_clip.h"
 #include "presplit_parallel.h"
+#include "float_mode.h"
 
 namespace asval::builder {
 namespace {
@@ -86,6 +87,7 @@ inline double FiniteArea(const PrimRef& r) {
 
 uint32_t SplitLargeTriangles(const TriangleGeometryView* geometries, size_t geometryCount,
                              const BuildOptions& options, BuildInput* input) {
+    const detail::FloatModeGuard mode;
     std::vector<PrimRef>& refs = input->refs;
     if (options.spatialSplits == SpatialSplits::Off || refs.empty()) return 0;
     // Pieces clip the time-0 triangle only: a moving triangle would leave its pieces at t > 0.
@@ -191,6 +193,7 @@ uint32_t SplitLargeTriangles(const TriangleGeometryView* geometries, size_t geom
 
 Bvh BuildTriangleBvh(const TriangleGeometryView* geometries, size_t geometryCount, bool allowUpdate,
                      const BuildOptions& options, BuildInput* excludedCounts) {
+    const detail::FloatModeGuard mode;
     BuildInput in;
     uint32_t base = 0;
     for (size_t g = 0; g < geometryCount; ++g) {

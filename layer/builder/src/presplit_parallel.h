@@ -9,12 +9,15 @@
 #include <thread>
 #include <vector>
 
+#include "float_mode.h"
+
 namespace asval::builder::detail {
 
 template <class Fn>
 void ForEachChunk(uint32_t threads, size_t chunks, Fn&& fn) {
     std::atomic<size_t> next{0};
     auto work = [&] {
+        const FloatModeGuard mode;  // a new thread's mode is not the caller's guarded one everywhere
         for (size_t c; (c = next.fetch_add(1, std::memory_order_relaxed)) < chunks;) fn(c);
     };
     const size_t helpers = std::min<size_t>(std::max<uint32_t>(threads, 1) - 1, chunks > 0 ? chunks - 1 : 0);
