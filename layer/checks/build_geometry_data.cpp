@@ -33,7 +33,7 @@ enum class DataRule { kStrideMultiple, kStrideMax, kVertexFormat, kIndexType, kA
       return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureGeometryTrianglesDataKHR-vertexStride-03735",
                          triangles("vertexStride"), "({}) is not a multiple of {} bytes, the {} of vertexFormat {}.",
                          tri.vertexStride, alignment.bytes,
-                         alignment.packed ? "size of the packed format" : "component size",
+                         alignment.What(),
                          string_VkFormat(tri.vertexFormat));
     }
     case DataRule::kStrideMax:

@@ -22,9 +22,7 @@ enum class Input { kVertexData, kIndexData, kTransformData, kAabbData, kInstance
   std::string why;
   switch (input) {
     case Input::kVertexData:
-      why = fmt::format(", the {} of vertexFormat {}",
-                        AlignmentOfVertexFormat(g.geometry.triangles.vertexFormat).packed ? "size of the packed format"
-                                                                                          : "component size",
+      why = fmt::format(", the {} of vertexFormat {}", AlignmentOfVertexFormat(g.geometry.triangles.vertexFormat).What(),
                         string_VkFormat(g.geometry.triangles.vertexFormat));
       break;
     case Input::kIndexData:

@@ -42,7 +42,7 @@ enum class RangeRule { kIndexOffset, kVertexOffset, kTransformOffset, kAabbOffse
                          range_field("primitiveOffset"),
                          "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
                          range.primitiveOffset, alignment.bytes,
-                         alignment.packed ? "size of the packed format" : "component size",
+                         alignment.What(),
                          string_VkFormat(tri.vertexFormat));
     }
     case RangeRule::kTransformOffset:

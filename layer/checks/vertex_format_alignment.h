@@ -15,6 +15,9 @@ struct VertexFormatAlignment {
   // describe (depth, compressed, multi-planar, newer than the headers).
   uint32_t bytes = 0;
   bool packed = false;  // true: bytes is the packed size of the whole texel
+
+  // What `bytes` is, for messages: "... is not a multiple of 4 bytes, the component size of ...".
+  const char* What() const { return packed ? "size of the packed format" : "component size"; }
 };
 
 namespace vertex_format_detail {

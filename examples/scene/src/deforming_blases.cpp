@@ -70,11 +70,7 @@ DeformingBlases::DeformingBlases(Gpu& gpu) : gpu_(gpu), meshes_(MakeDeformingMes
 }
 
 DeformingBlases::~DeformingBlases() {
-  VkDevice d = gpu_.device();
-  vkDestroyDescriptorPool(d, descriptor_pool_, nullptr);
-  vkDestroyPipeline(d, pipeline_, nullptr);
-  vkDestroyPipelineLayout(d, pipeline_layout_, nullptr);
-  vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+  gpu_.Destroy(pipe_);
   gpu_.Destroy(flag_);
   gpu_.Destroy(blob_);
   gpu_.Destroy(scratch_);
@@ -97,11 +93,11 @@ void DeformingBlases::CreatePipeline() {
   VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   set_info.bindingCount = static_cast<uint32_t>(bindings.size());
   set_info.pBindings = bindings.data();
-  Check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  Check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &pipe_.set_layout), "vkCreateDescriptorSetLayout");
   VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout_info.setLayoutCount = 1;
-  layout_info.pSetLayouts = &set_layout_;
-  Check(vkCreatePipelineLayout(d, &layout_info, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
+  layout_info.pSetLayouts = &pipe_.set_layout;
+  Check(vkCreatePipelineLayout(d, &layout_info, nullptr, &pipe_.layout), "vkCreatePipelineLayout");
 
   VkShaderModule module = CreateShaderModule(d, Shader::kDeform);
   VkComputePipelineCreateInfo pipeline_info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
@@ -109,8 +105,8 @@ void DeformingBlases::CreatePipeline() {
   pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   pipeline_info.stage.module = module;
   pipeline_info.stage.pName = "main";
-  pipeline_info.layout = pipeline_layout_;
-  Check(vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline_), "vkCreateComputePipelines");
+  pipeline_info.layout = pipe_.layout;
+  Check(vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipe_.pipeline), "vkCreateComputePipelines");
   vkDestroyShaderModule(d, module, nullptr);
 
   VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 6};
@@ -118,10 +114,10 @@ void DeformingBlases::CreatePipeline() {
   pool_info.maxSets = 2;
   pool_info.poolSizeCount = 1;
   pool_info.pPoolSizes = &pool_size;
-  Check(vkCreateDescriptorPool(d, &pool_info, nullptr, &descriptor_pool_), "vkCreateDescriptorPool");
-  const std::array<VkDescriptorSetLayout, 2> layouts{set_layout_, set_layout_};
+  Check(vkCreateDescriptorPool(d, &pool_info, nullptr, &pipe_.descriptor_pool), "vkCreateDescriptorPool");
+  const std::array<VkDescriptorSetLayout, 2> layouts{pipe_.set_layout, pipe_.set_layout};
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = descriptor_pool_;
+  alloc.descriptorPool = pipe_.descriptor_pool;
   alloc.descriptorSetCount = 2;
   alloc.pSetLayouts = layouts.data();
   Check(vkAllocateDescriptorSets(d, &alloc, sets_.data()), "vkAllocateDescriptorSets");
@@ -175,8 +171,8 @@ BuildInput DeformingBlases::WithCompactionFlag(BuildInput input) {
 }
 
 void DeformingBlases::RecordAnimate(VkCommandBuffer cb, uint32_t parity) const {
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &sets_[parity], 0, nullptr);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe_.pipeline);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe_.layout, 0, 1, &sets_[parity], 0, nullptr);
   vkCmdDispatch(cb, static_cast<uint32_t>((meshes_.rest.size() + 63) / 64), 1, 1);
   Barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, kBuildStage, kBuildReads);
 }

@@ -65,10 +65,7 @@ class DeformingBlases {
   Buffer scratch_;
   VkDeviceSize blob_scratch_offset_ = 0;
 
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  PipelineObjects pipe_;
   std::array<VkDescriptorSet, 2> sets_{};
 };
 

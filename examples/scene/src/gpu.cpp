@@ -223,6 +223,14 @@ void Gpu::Destroy(MemoryBlock& block) {
   block = MemoryBlock{};
 }
 
+void Gpu::Destroy(PipelineObjects& p) {
+  vkDestroyDescriptorPool(device_, p.descriptor_pool, nullptr);
+  vkDestroyPipeline(device_, p.pipeline, nullptr);
+  vkDestroyPipelineLayout(device_, p.layout, nullptr);
+  vkDestroyDescriptorSetLayout(device_, p.set_layout, nullptr);
+  p = PipelineObjects{};
+}
+
 AccelerationStructure Gpu::CreateAccelerationStructure(VkAccelerationStructureTypeKHR type, VkDeviceSize size,
                                                        const char* name) {
   AccelerationStructure as;

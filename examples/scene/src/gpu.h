@@ -25,6 +25,14 @@ struct MemoryBlock {
   void* mapped = nullptr;
 };
 
+// A compute or ray-tracing pass's pipeline and what it was made from: destroyed together.
+struct PipelineObjects {
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+};
+
 struct AccelerationStructure {
   VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
   Buffer storage;
@@ -72,6 +80,7 @@ class Gpu {
   Buffer CreateBufferIn(MemoryBlock& block, VkDeviceSize size, VkBufferUsageFlags usage);
   void Destroy(Buffer& buffer);  // frees the memory only of dedicated buffers
   void Destroy(MemoryBlock& block);
+  void Destroy(PipelineObjects& p);
 
   AccelerationStructure CreateAccelerationStructure(VkAccelerationStructureTypeKHR type, VkDeviceSize size,
                                                     const char* name);

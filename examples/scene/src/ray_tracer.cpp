@@ -31,11 +31,7 @@ RayTracer::RayTracer(Gpu& gpu, uint32_t width, uint32_t height) : gpu_(gpu), wid
 }
 
 RayTracer::~RayTracer() {
-  VkDevice d = gpu_.device();
-  vkDestroyDescriptorPool(d, descriptor_pool_, nullptr);
-  vkDestroyPipeline(d, pipeline_, nullptr);
-  vkDestroyPipelineLayout(d, pipeline_layout_, nullptr);
-  vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+  gpu_.Destroy(pipe_);
   gpu_.Destroy(sbt_);
   gpu_.Destroy(camera_);
   gpu_.Destroy(image_);
@@ -52,11 +48,11 @@ void RayTracer::CreatePipeline() {
   VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   set_info.bindingCount = static_cast<uint32_t>(bindings.size());
   set_info.pBindings = bindings.data();
-  Check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  Check(vkCreateDescriptorSetLayout(d, &set_info, nullptr, &pipe_.set_layout), "vkCreateDescriptorSetLayout");
   VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout_info.setLayoutCount = 1;
-  layout_info.pSetLayouts = &set_layout_;
-  Check(vkCreatePipelineLayout(d, &layout_info, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
+  layout_info.pSetLayouts = &pipe_.set_layout;
+  Check(vkCreatePipelineLayout(d, &layout_info, nullptr, &pipe_.layout), "vkCreatePipelineLayout");
 
   struct StageSource {
     Shader shader;
@@ -98,8 +94,8 @@ void RayTracer::CreatePipeline() {
   info.groupCount = static_cast<uint32_t>(groups.size());
   info.pGroups = groups.data();
   info.maxPipelineRayRecursionDepth = 2;  // primary ray, then the shadow ray from the hit shaders
-  info.layout = pipeline_layout_;
-  Check(gpu_.vk().CreateRayTracingPipelinesKHR(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_),
+  info.layout = pipe_.layout;
+  Check(gpu_.vk().CreateRayTracingPipelinesKHR(d, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &info, nullptr, &pipe_.pipeline),
         "vkCreateRayTracingPipelinesKHR");
   for (const VkPipelineShaderStageCreateInfo& s : stages) vkDestroyShaderModule(d, s.module, nullptr);
 
@@ -109,11 +105,11 @@ void RayTracer::CreatePipeline() {
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = static_cast<uint32_t>(pool_sizes.size());
   pool_info.pPoolSizes = pool_sizes.data();
-  Check(vkCreateDescriptorPool(d, &pool_info, nullptr, &descriptor_pool_), "vkCreateDescriptorPool");
+  Check(vkCreateDescriptorPool(d, &pool_info, nullptr, &pipe_.descriptor_pool), "vkCreateDescriptorPool");
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = descriptor_pool_;
+  alloc.descriptorPool = pipe_.descriptor_pool;
   alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &set_layout_;
+  alloc.pSetLayouts = &pipe_.set_layout;
   Check(vkAllocateDescriptorSets(d, &alloc, &set_), "vkAllocateDescriptorSets");
 }
 
@@ -123,7 +119,7 @@ void RayTracer::CreateShaderBindingTable() {
   const VkDeviceSize record = AlignUp(handle_size, p.shaderGroupHandleAlignment);
   const VkDeviceSize base = p.shaderGroupBaseAlignment;
   std::vector<uint8_t> handles(size_t{kGroupCount} * handle_size);
-  Check(gpu_.vk().GetRayTracingShaderGroupHandlesKHR(gpu_.device(), pipeline_, 0, kGroupCount, handles.size(),
+  Check(gpu_.vk().GetRayTracingShaderGroupHandlesKHR(gpu_.device(), pipe_.pipeline, 0, kGroupCount, handles.size(),
                                                      handles.data()),
         "vkGetRayTracingShaderGroupHandlesKHR");
   // Three regions, each starting at a multiple of shaderGroupBaseAlignment: raygen | sky, shadow | triangles, spheres.
@@ -190,8 +186,8 @@ void RayTracer::SetCamera(const float eye[3], const float target[3], float verti
 }
 
 void RayTracer::RecordTrace(VkCommandBuffer cb) const {
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_);
-  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_layout_, 0, 1, &set_, 0, nullptr);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipe_.pipeline);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipe_.layout, 0, 1, &set_, 0, nullptr);
   gpu_.vk().CmdTraceRaysKHR(cb, &raygen_region_, &miss_region_, &hit_region_, &callable_region_, width_, height_, 1);
   const VkPipelineStageFlags host = VK_PIPELINE_STAGE_HOST_BIT;
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};

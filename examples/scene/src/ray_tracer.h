@@ -39,10 +39,7 @@ class RayTracer {
   VkStridedDeviceAddressRegionKHR miss_region_{};
   VkStridedDeviceAddressRegionKHR hit_region_{};
   VkStridedDeviceAddressRegionKHR callable_region_{};
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  PipelineObjects pipe_;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
 };
 

@@ -118,20 +118,42 @@ bool Keep(uint8_t s, bool allowUpdate, BuildInput* out) {
     return true;
 }
 
+// What both triangle paths need before computing boxes: each primitive's state, the format, the index
+// size and the transform (when one is given and readable).
+struct TriangleSetup {
+    std::vector<uint8_t> states;
+    const VertexFormatInfo* info = nullptr;
+    int indexBytes = 0;
+    bool transformed = false;
+    float m[12] = {};
+
+    // False (everything counted unreadable) when the geometry cannot be classified.
+    bool Prepare(const TriangleGeometryView& view, BuildInput* out) {
+        const uint32_t n = view.range.primitiveCount;
+        states.resize(n);
+        const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());
+        if (cr.status != ClassifyStatus::Ok) { out->excludedUnreadable += n; return false; }
+        info = FindVertexFormat(view.vertexFormat);
+        indexBytes = IndexTypeBytes(view.indexType);
+        transformed = view.transformData && !cr.transformUnreadable;
+        if (transformed)
+            std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
+        return true;
+    }
+};
+
 // Motion triangles: the union of the conservative boxes of the triangle at time 0 and at time 1. A vertex
 // at time t is (1 - t) v0 + t v1 and the (affine) transform keeps that a convex combination of the two
 // transformed ends, so the triangle at every t lies in the hull of its six transformed vertices.
 void AppendMotionTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
+    TriangleSetup set;
+    if (!set.Prepare(view, out)) return;  // classified by the motion rules
     const uint32_t n = view.range.primitiveCount;
-    std::vector<uint8_t> states(n);
-    const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());  // the motion rules
-    if (cr.status != ClassifyStatus::Ok) { out->excludedUnreadable += n; return; }
-    const VertexFormatInfo& info = *FindVertexFormat(view.vertexFormat);
-    const int indexBytes = IndexTypeBytes(view.indexType);
-    float m[12];
-    const bool transformed = view.transformData && !cr.transformUnreadable;
-    if (transformed)
-        std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
+    const std::vector<uint8_t>& states = set.states;
+    const VertexFormatInfo& info = *set.info;
+    const int indexBytes = set.indexBytes;
+    const bool transformed = set.transformed;
+    const float* const m = set.m;
     const uint8_t* const buffers[2] = {static_cast<const uint8_t*>(view.vertexData),
                                        static_cast<const uint8_t*>(view.motionVertexData)};
     out->refs.reserve(out->refs.size() + n);
@@ -151,16 +173,14 @@ void AppendMotionTriangles(const TriangleGeometryView& view, bool allowUpdate, u
 void AppendTriangles(const TriangleGeometryView& view, bool allowUpdate, uint32_t idBase, BuildInput* out) {
     const detail::FloatModeGuard mode;
     if (view.motionVertexData) { AppendMotionTriangles(view, allowUpdate, idBase, out); return; }
+    TriangleSetup set;
+    if (!set.Prepare(view, out)) return;
     const uint32_t n = view.range.primitiveCount;
-    std::vector<uint8_t> states(n);
-    const ClassifyResult cr = ClassifyTriangles(view, nullptr, states.data());
-    if (cr.status != ClassifyStatus::Ok) { out->excludedUnreadable += n; return; }
-    const VertexFormatInfo& info = *FindVertexFormat(view.vertexFormat);
-    const int indexBytes = IndexTypeBytes(view.indexType);
-    float m[12];
-    const bool transformed = view.transformData && !cr.transformUnreadable;
-    if (transformed)
-        std::memcpy(m, static_cast<const uint8_t*>(view.transformData) + view.range.transformOffset, sizeof m);
+    const std::vector<uint8_t>& states = set.states;
+    const VertexFormatInfo& info = *set.info;
+    const int indexBytes = set.indexBytes;
+    const bool transformed = set.transformed;
+    const float* const m = set.m;
     const auto* vb = static_cast<const uint8_t*>(view.vertexData);
     // Only dereferenced for readable (kept) primitives; never offset a null pointer.
     const auto* ib = indexBytes && view.indexData ? static_cast<const uint8_t*>(view.indexData) + view.range.primitiveOffset : nullptr;
