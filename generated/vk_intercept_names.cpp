@@ -39,6 +39,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyDevice",
     "vkDestroyInstance",
     "vkDestroyQueryPool",
+    "vkEndCommandBuffer",
     "vkFreeCommandBuffers",
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
@@ -88,6 +89,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkDestroyDevice
     false,  // vkDestroyInstance
     true,  // vkDestroyQueryPool
+    true,  // vkEndCommandBuffer
     true,  // vkFreeCommandBuffers
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR

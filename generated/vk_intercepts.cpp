@@ -43,6 +43,7 @@ const InterceptEntry kIntercepts[] = {
     {"vkDestroyDevice", reinterpret_cast<PFN_vkVoidFunction>(&DestroyDevice), true},
     {"vkDestroyInstance", reinterpret_cast<PFN_vkVoidFunction>(&DestroyInstance), false},
     {"vkDestroyQueryPool", reinterpret_cast<PFN_vkVoidFunction>(&DestroyQueryPool), true},
+    {"vkEndCommandBuffer", reinterpret_cast<PFN_vkVoidFunction>(&EndCommandBuffer), true},
     {"vkFreeCommandBuffers", reinterpret_cast<PFN_vkVoidFunction>(&FreeCommandBuffers), true},
     {"vkFreeMemory", reinterpret_cast<PFN_vkVoidFunction>(&FreeMemory), true},
     {"vkGetDeferredOperationResultKHR", reinterpret_cast<PFN_vkVoidFunction>(&GetDeferredOperationResultKHR), true},

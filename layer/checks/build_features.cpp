@@ -28,10 +28,9 @@ RequiredFeature FeatureFor(const DeviceFeatures& f, BuildCommandKind kind) {
 }
 
 bool ValidateProtectedCommandBuffer(const CheckContext& ctx, const BuildCommand& cmd) {
-  const CommandBufferLevels& levels = ctx.state.command_buffer_levels;
   // No protected pool was ever created on this device: no command buffer can be protected.
-  if (!levels.any_protected_pool.load(std::memory_order_acquire)) return false;
-  const std::optional<CommandBufferInfo> info = levels.Find(cmd.command_buffer);
+  if (!ctx.state.command_buffers.AnyProtectedPool()) return false;
+  const std::shared_ptr<CommandBufferState> info = ctx.state.command_buffers.Find(cmd.command_buffer);
   if (!info) {
     CountUnknownState(ctx);
     return false;

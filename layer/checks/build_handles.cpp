@@ -1,5 +1,7 @@
 #include "build_handles.h"
 
+#include "structure_memory.h"
+
 #include <algorithm>
 #include <utility>
 #include <vector>
@@ -48,12 +50,12 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
 bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const AccelerationStructureState& as,
                    const char* vuid, const char* field) {
   if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup
-  const std::optional<std::shared_ptr<const BufferState>> buffer = ctx.state.buffers.find(as.buffer);
-  if (!buffer || !*buffer || ((*buffer)->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
+  const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, as);
+  if (!buffer || (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
     CountUnknownState(ctx);
     return false;
   }
-  if ((*buffer)->bound) return false;
+  if (buffer->bound) return false;
   return ReportBuild(ctx, cmd, i, vuid, [&](std::string&) { return InfoLocation(cmd, i).Field(field); },
                      "(0x{:x}) was created on VkBuffer 0x{:x}, which is not bound to device memory (no "
                      "vkBindBufferMemory or vkBindBufferMemory2 for it succeeded).",

@@ -4,7 +4,7 @@
 
 #include "build_report.h"
 #include "build_sizes.h"
-#include "history_record.h"
+#include "history_recorder.h"
 #include "host_instances.h"
 #include "structure_memory.h"
 #include "vk_enum_string.h"
@@ -201,7 +201,7 @@ bool ValidateHostInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32
 bool ValidateDeferredOperation(const CheckContext& ctx, const BuildCommand& cmd) {
   if (cmd.deferred_operation == VK_NULL_HANDLE) return false;
   // HasDeferredOps only reads, under the history's own mutex; DeviceData owns the state as non-const.
-  if (!HasDeferredOps(const_cast<DeviceState&>(ctx.state), cmd.deferred_operation)) return false;
+  if (!HasDeferredOps(ctx.state, cmd.deferred_operation)) return false;
   return ReportBuild(ctx, cmd, kNoInfo, "deferredOperation-03678",
                      [&](std::string&) { return cmd.Root().Field("deferredOperation"); },
                      "(VkDeferredOperationKHR 0x{:x}) is still associated with an earlier host command that returned "

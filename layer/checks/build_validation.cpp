@@ -7,7 +7,7 @@
 #include "build_memory_pass.h"
 #include "build_ranges.h"
 #include "build_structure.h"
-#include "history_record.h"
+#include "history_host.h"
 
 namespace asval {
 

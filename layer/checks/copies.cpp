@@ -1,5 +1,7 @@
 #include "copies.h"
 
+#include "structure_memory.h"
+
 #include <fmt/format.h>
 
 #include "history_apply.h"
@@ -45,10 +47,10 @@ Bound StructureBufferBound(const CheckContext& ctx, VkAccelerationStructureKHR a
   std::optional<std::shared_ptr<const AccelerationStructureState>> record = ctx.state.acceleration_structures.find(as);
   if (!record || !*record) return Bound::kUnknown;
   *buffer_out = (*record)->buffer;
-  std::optional<std::shared_ptr<const BufferState>> buffer = ctx.state.buffers.find((*record)->buffer);
-  if (!buffer || !*buffer) return Bound::kUnknown;
-  if ((*buffer)->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return Bound::kUnknown;
-  return (*buffer)->bound ? Bound::kYes : Bound::kNo;
+  const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, **record);
+  if (!buffer) return Bound::kUnknown;
+  if (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return Bound::kUnknown;
+  return buffer->bound ? Bound::kYes : Bound::kNo;
 }
 
 bool CheckBound(const CheckContext& ctx, VkCommandBuffer cb, VkAccelerationStructureKHR as, const VuidName& vuid,

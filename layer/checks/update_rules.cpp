@@ -67,7 +67,7 @@ const AsHistory* ReadableHistory(const OpReporter& r, VkAccelerationStructureKHR
       r.CountSkip();
       return nullptr;
     }
-    *storage = r.store.Get(as);  // never built, or unknown after lost operations
+    *storage = r.store.Get(as);  // live, without a record: never built
     h = storage;
   }
   if (h->kind == HistoryKind::kUnknown) {
@@ -180,7 +180,9 @@ std::string LastBuilt(const OpReporter& r, const BuildSnapshot& s) {
 }
 
 // The clean path: an update that repeats its source's last build compares equal and formats nothing.
-bool UpdateMatches(const OpReporter& r, const BuildSnapshot& s) {
+// *unknown_counts: geometries whose primitive count one side does not know (an indirect build's count lives
+// on the device); counted as skips by the caller, once (CompareUpdate counts them itself).
+bool UpdateMatches(const OpReporter& r, const BuildSnapshot& s, uint32_t* unknown_counts) {
   const AsOp& op = r.op;
   if (!(s.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) || s.flags != op.flags || s.type != op.type ||
       s.geometries.size() != op.geometry_count) {
@@ -197,7 +199,7 @@ bool UpdateMatches(const OpReporter& r, const BuildSnapshot& s) {
       return false;
     }
     if (!g.primitive_count_known || !b.primitive_count_known) {
-      r.CountSkip();
+      ++*unknown_counts;
     } else if (g.primitive_count != b.primitive_count) {
       return false;
     }
@@ -214,7 +216,16 @@ void CheckUpdate(const OpReporter& r) {
     ReportNeverBuiltSource(r);
     return;
   }
-  if (!UpdateMatches(r, *h->build)) CompareUpdate(r, *h->build);
+  if (r.op.geometries_unreadable) {
+    r.CountSkip();  // a null geometry pointer: the structure family reports it; nothing to compare
+    return;
+  }
+  uint32_t unknown_counts = 0;
+  if (!UpdateMatches(r, *h->build, &unknown_counts)) {
+    CompareUpdate(r, *h->build);
+    return;
+  }
+  for (uint32_t k = 0; k < unknown_counts; ++k) r.CountSkip();
 }
 
 // ---- copies, serialization, property queries -----------------------------------------------------------------

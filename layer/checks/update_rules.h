@@ -10,7 +10,7 @@
 //   aliasing: ASVAL-History-Clobbered (warning): a source whose memory another operation wrote since it was built
 // and, in the copies family (it needs the history's serialization size),
 //             VkCopyAccelerationStructureToMemoryInfoKHR-dst-03561.
-// Device commands are checked when submitted (history_submit.h), host commands when called. A structure whose
+// Device commands are checked when submitted (submit_checks.h), host commands when called. A structure whose
 // history is unknown is skipped, and the skip counted; never guessed.
 #include <vulkan/vulkan.h>
 

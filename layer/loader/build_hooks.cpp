@@ -1,19 +1,12 @@
 // The acceleration-structure build commands: describe the call as a BuildCommand, run the enabled rule
-// families over it, then pass the call down unless the app's callback asked to skip it.
+// families over it (validate), pass the call down unless the app's callback asked to skip it, then record
+// what it does to the structures' histories (post-record).
 #include "build_validation.h"
-#include "history_record.h"
+#include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
-
-namespace {
-
-CheckContext MakeCheckContext(const DeviceData& data) {
-  return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
-}
-
-}  // namespace
 
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
     VkCommandBuffer commandBuffer, uint32_t infoCount, const VkAccelerationStructureBuildGeometryInfoKHR* pInfos,
@@ -27,7 +20,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.ranges = ppBuildRangeInfos;
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
-  RecordDeviceBuild(data->state, data->instance->settings.enabled_checks, cmd);  // history: applied at submission
+  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuild, infoCount, pInfos, ppBuildRangeInfos);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
@@ -46,7 +39,8 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);
-  RecordDeviceBuild(data->state, data->instance->settings.enabled_checks, cmd);  // history: applied at submission
+  // The ranges (and so the primitive counts) are on the device.
+  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuildIndirect, infoCount, pInfos, nullptr);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
@@ -66,7 +60,7 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
   const VkResult result =
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
   // History: applied now on success, or when the deferred operation completes.
-  FinishHostBuild(data->state, data->instance->settings.enabled_checks, cmd, result);
+  FinishHostOps(data->state, HostBuildOps(infoCount, pInfos, ppBuildRangeInfos), deferredOperation, result);
   return result;
 }
 

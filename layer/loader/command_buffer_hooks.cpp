@@ -1,33 +1,72 @@
-// Command-buffer lifetime for the build history: beginning or resetting a command buffer empties its
-// operation log, and vkCmdExecuteCommands copies the secondaries' operations into the primary's log.
-// (Allocation, freeing and pool destruction are hooked in command_buffer_level_hooks.cpp, which fills both the
-// level records and the operation logs.)
-#include "history_record.h"
+// Command pools and command buffers: which pool each command buffer came from, its level, whether it is
+// protected (commandBuffer-09547), and the acceleration-structure operations each recording holds
+// (CommandBufferMap, layer/state/command_buffers.h).
+#include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
 
-VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer commandBuffer,
-                                                  const VkCommandBufferBeginInfo* pBeginInfo) {
-  DeviceData* data = GetDeviceData(commandBuffer);
-  // vkBeginCommandBuffer resets a recorded command buffer implicitly.
-  ResetCommandBufferLog(data->state, commandBuffer);
-  return data->dispatch.BeginCommandBuffer(commandBuffer, pBeginInfo);
+VKAPI_ATTR VkResult VKAPI_CALL CreateCommandPool(VkDevice device, const VkCommandPoolCreateInfo* pCreateInfo,
+                                                 const VkAllocationCallbacks* pAllocator, VkCommandPool* pCommandPool) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateCommandPool(device, pCreateInfo, pAllocator, pCommandPool);
+  if (result == VK_SUCCESS) data->state.command_buffers.CreatePool(*pCommandPool, pCreateInfo->flags);
+  return result;
 }
 
-VKAPI_ATTR VkResult VKAPI_CALL ResetCommandBuffer(VkCommandBuffer commandBuffer, VkCommandBufferResetFlags flags) {
-  DeviceData* data = GetDeviceData(commandBuffer);
-  const VkResult result = data->dispatch.ResetCommandBuffer(commandBuffer, flags);
-  if (result == VK_SUCCESS) ResetCommandBufferLog(data->state, commandBuffer);
-  return result;
+VKAPI_ATTR void VKAPI_CALL DestroyCommandPool(VkDevice device, VkCommandPool commandPool,
+                                              const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  // Before the downcall: see CommandBufferMap::DestroyPool.
+  if (commandPool) data->state.command_buffers.DestroyPool(commandPool);
+  data->dispatch.DestroyCommandPool(device, commandPool, pAllocator);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL ResetCommandPool(VkDevice device, VkCommandPool commandPool,
                                                 VkCommandPoolResetFlags flags) {
   DeviceData* data = GetDeviceData(device);
   const VkResult result = data->dispatch.ResetCommandPool(device, commandPool, flags);
-  if (result == VK_SUCCESS) data->state.history.command_buffers.ResetPool(commandPool);
+  if (result == VK_SUCCESS) data->state.command_buffers.ResetPool(commandPool);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL AllocateCommandBuffers(VkDevice device, const VkCommandBufferAllocateInfo* pAllocateInfo,
+                                                      VkCommandBuffer* pCommandBuffers) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.AllocateCommandBuffers(device, pAllocateInfo, pCommandBuffers);
+  if (result == VK_SUCCESS) data->state.command_buffers.Allocate(*pAllocateInfo, pCommandBuffers);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL FreeCommandBuffers(VkDevice device, VkCommandPool commandPool, uint32_t commandBufferCount,
+                                              const VkCommandBuffer* pCommandBuffers) {
+  DeviceData* data = GetDeviceData(device);
+  // Before the downcall, for the same reason as in DestroyCommandPool.
+  data->state.command_buffers.Free(commandBufferCount, pCommandBuffers);
+  data->dispatch.FreeCommandBuffers(device, commandPool, commandBufferCount, pCommandBuffers);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer commandBuffer,
+                                                  const VkCommandBufferBeginInfo* pBeginInfo) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const VkResult result = data->dispatch.BeginCommandBuffer(commandBuffer, pBeginInfo);
+  // vkBeginCommandBuffer resets a recorded command buffer implicitly.
+  if (result == VK_SUCCESS) data->state.command_buffers.Reset(commandBuffer);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL EndCommandBuffer(VkCommandBuffer commandBuffer) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const VkResult result = data->dispatch.EndCommandBuffer(commandBuffer);
+  if (result == VK_SUCCESS) data->state.command_buffers.End(commandBuffer);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL ResetCommandBuffer(VkCommandBuffer commandBuffer, VkCommandBufferResetFlags flags) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  const VkResult result = data->dispatch.ResetCommandBuffer(commandBuffer, flags);
+  if (result == VK_SUCCESS) data->state.command_buffers.Reset(commandBuffer);
   return result;
 }
 
@@ -35,8 +74,7 @@ VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uin
                                               const VkCommandBuffer* pCommandBuffers) {
   DeviceData* data = GetDeviceData(commandBuffer);
   data->dispatch.CmdExecuteCommands(commandBuffer, commandBufferCount, pCommandBuffers);
-  RecordExecuteCommands(data->state, data->instance->settings.enabled_checks, commandBuffer, commandBufferCount,
-                        pCommandBuffers);
+  RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);
 }
 
 }  // namespace asval::hooks

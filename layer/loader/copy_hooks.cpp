@@ -2,18 +2,14 @@
 // rules, then (after a successful downcall) the operation for the build history: logged into the command
 // buffer (device commands, applied at submission) or checked now and applied on completion (host commands).
 #include "copies.h"
-#include "history_record.h"
-#include "history_submit.h"
+#include "history_host.h"
+#include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
 
 namespace {
-
-CheckContext MakeCheckContext(const DeviceData& data) {
-  return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
-}
 
 // A host copy: record-time rules, history rules, the downcall, and its operations applied (or deferred).
 template <typename MakeOps, typename Validate, typename Downcall>
@@ -22,15 +18,13 @@ VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR
   const CheckContext ctx = MakeCheckContext(data);
   bool skip = ctx.Enabled(kCheckCopies) && validate(ctx);
   OpBatch batch;
-  if (HistoryTracked(ctx.enabled_checks)) {
-    batch = make_ops();
-    skip |= CheckHostOps(data.state, *data.reporter, ctx.enabled_checks, batch, function);
-  }
+  if (data.state.history_tracked) batch = make_ops();
+  skip |= ValidateHostOps(ctx, batch, function);
   // Skipped by the app's callback: the copy did not happen (VK_ERROR_VALIDATION_FAILED_EXT, as the Khronos
   // layer returns).
   if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
   const VkResult result = downcall();
-  FinishHostOps(data.state, ctx.enabled_checks, std::move(batch), deferred, result);
+  FinishHostOps(data.state, std::move(batch), deferred, result);
   return result;
 }
 
@@ -45,7 +39,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureKHR(VkCommandBuffer comma
     return;
   }
   data->dispatch.CmdCopyAccelerationStructureKHR(commandBuffer, pInfo);
-  if (pInfo) RecordDeviceCopy(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+  if (pInfo) RecordCmdCopy(data->state, commandBuffer, *pInfo);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
@@ -57,7 +51,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
     return;
   }
   data->dispatch.CmdCopyAccelerationStructureToMemoryKHR(commandBuffer, pInfo);
-  if (pInfo) RecordDeviceCopyToMemory(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+  if (pInfo) RecordCmdCopyToMemory(data->state, commandBuffer, *pInfo);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
@@ -69,7 +63,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
     return;
   }
   data->dispatch.CmdCopyMemoryToAccelerationStructureKHR(commandBuffer, pInfo);
-  if (pInfo) RecordDeviceCopyMemoryTo(data->state, ctx.enabled_checks, commandBuffer, *pInfo);
+  if (pInfo) RecordCmdCopyMemoryTo(data->state, commandBuffer, *pInfo);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(
@@ -85,8 +79,8 @@ VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(
   }
   data->dispatch.CmdWriteAccelerationStructuresPropertiesKHR(commandBuffer, accelerationStructureCount,
                                                              pAccelerationStructures, queryType, queryPool, firstQuery);
-  RecordDeviceWriteProperties(data->state, ctx.enabled_checks, commandBuffer, accelerationStructureCount,
-                              pAccelerationStructures, queryType, queryPool, firstQuery);
+  RecordCmdWriteProperties(data->state, commandBuffer, accelerationStructureCount, pAccelerationStructures, queryType,
+                           queryPool, firstQuery);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkDeferredOperationKHR deferredOperation,
@@ -133,15 +127,14 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
   bool skip = ctx.Enabled(kCheckCopies) &&
               ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount,
                                       pAccelerationStructures, queryType, VK_NULL_HANDLE, 0);
-  if (HistoryTracked(ctx.enabled_checks)) {
-    const OpBatch batch = HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType);
-    skip |= CheckHostOps(data->state, *data->reporter, ctx.enabled_checks, batch, function);
+  if (data->state.history_tracked) {
+    skip |= ValidateHostOps(ctx, HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType),
+                            function);
   }
   if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
   const VkResult result = data->dispatch.WriteAccelerationStructuresPropertiesKHR(
       device, accelerationStructureCount, pAccelerationStructures, queryType, dataSize, pData, stride);
-  if (result == VK_SUCCESS && queryType == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR &&
-      HistoryTracked(ctx.enabled_checks)) {
+  if (result == VK_SUCCESS && queryType == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) {
     RecordHostSerializationSizes(data->state, accelerationStructureCount, pAccelerationStructures, pData, stride);
   }
   return result;

@@ -2,7 +2,7 @@
 // structures' histories only once the layer sees it complete successfully: vkDeferredOperationJoinKHR or
 // vkGetDeferredOperationResultKHR reporting completion, or, at the latest, vkDestroyDeferredOperationKHR
 // (the app may destroy a completed operation without asking for its result).
-#include "history_record.h"
+#include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 

@@ -1,6 +1,6 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
-#include "history_record.h"
+#include "history_host.h"
 #include "layer_data.h"
 #include "state_tracker.h"
 #include "vk_intercepts.h"
@@ -19,7 +19,9 @@ VKAPI_ATTR VkResult VKAPI_CALL SetDebugUtilsObjectNameEXT(VkDevice device,
   DeviceData* data = GetDeviceData(device);
   if (!data) return VK_ERROR_INITIALIZATION_FAILED;
   if (pNameInfo) data->reporter->SetObjectName(pNameInfo->objectHandle, pNameInfo->pObjectName);
-  if (!data->dispatch.SetDebugUtilsObjectNameEXT) return VK_SUCCESS;
+  // Always passed down: when the device chain has no entry for it (VK_EXT_debug_utils is an instance
+  // extension), CreateDevice filled the table from the next element's instance-level entry point.
+  if (!data->dispatch.SetDebugUtilsObjectNameEXT) return VK_ERROR_EXTENSION_NOT_PRESENT;  // never handed out then
   return data->dispatch.SetDebugUtilsObjectNameEXT(device, pNameInfo);
 }
 
@@ -89,10 +91,8 @@ VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
                                                            VkAccelerationStructureKHR accelerationStructure,
                                                            const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
-  if (accelerationStructure) {
-    RecordDestroyAccelerationStructure(data->state, accelerationStructure);
-    ForgetHistory(data->state, accelerationStructure);  // a new structure with this handle value starts fresh
-  }
+  // Before the downcall: afterwards the handle value may be handed out again by another thread.
+  if (accelerationStructure) RecordDestroyAccelerationStructure(data->state, accelerationStructure);
   data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
 }
 

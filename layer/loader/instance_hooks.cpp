@@ -134,6 +134,14 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   data->reporter = instance->reporter.get();
   data->next_gdpa = next_gdpa;
   InitDeviceDispatchTable(*pDevice, next_gdpa, &data->dispatch);
+  // vkSetDebugUtilsObjectNameEXT belongs to an instance extension: the chain may answer it only at instance
+  // level. The layer hands its hook out wherever the chain has the function, so it must always be able to
+  // pass the call down.
+  if (!data->dispatch.SetDebugUtilsObjectNameEXT) {
+    data->dispatch.SetDebugUtilsObjectNameEXT = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+        instance->next_gipa(instance->instance, "vkSetDebugUtilsObjectNameEXT"));
+  }
+  data->state.history_tracked = instance->settings.TracksHistory();
   data->state.features = ParseEnabledFeatures(*pCreateInfo);
   QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
   data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);

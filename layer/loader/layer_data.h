@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "check_context.h"
 #include "device_state.h"
 #include "dispatch_key.h"
 #include "layer_settings.h"
@@ -32,6 +33,11 @@ struct DeviceData {
   Reporter* reporter = nullptr;  // the instance's
   DeviceState state;
 };
+
+// What the validate functions of a hook see: the device's shadow state (const), the reporter, the families on.
+inline CheckContext MakeCheckContext(const DeviceData& data) {
+  return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
+}
 
 DispatchRegistry<InstanceData>& Instances();
 DispatchRegistry<DeviceData>& Devices();

@@ -2,6 +2,7 @@
 // pointers that start inside one can be checked against its end (build_host.h). vkFreeMemory unmaps too
 // (RecordFreeMemory).
 #include "layer_data.h"
+#include "state_tracker.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
@@ -10,20 +11,13 @@ VKAPI_ATTR VkResult VKAPI_CALL MapMemory(VkDevice device, VkDeviceMemory memory,
                                          VkMemoryMapFlags flags, void** ppData) {
   DeviceData* data = GetDeviceData(device);
   const VkResult result = data->dispatch.MapMemory(device, memory, offset, size, flags, ppData);
-  if (result != VK_SUCCESS || !ppData) return result;
-  VkDeviceSize bytes = size;
-  if (size == VK_WHOLE_SIZE) {
-    const std::optional<std::shared_ptr<const MemoryState>> record = data->state.memories.find(memory);
-    if (!record || !*record || (*record)->size < offset) return result;  // extent unknown: not recorded
-    bytes = (*record)->size - offset;
-  }
-  data->state.host_mappings.Map(memory, offset, bytes, *ppData);
+  if (result == VK_SUCCESS && ppData) RecordMapMemory(data->state, memory, offset, size, *ppData);
   return result;
 }
 
 VKAPI_ATTR void VKAPI_CALL UnmapMemory(VkDevice device, VkDeviceMemory memory) {
   DeviceData* data = GetDeviceData(device);
-  data->state.host_mappings.Unmap(memory);
+  RecordUnmapMemory(data->state, memory);
   data->dispatch.UnmapMemory(device, memory);
 }
 

@@ -115,12 +115,20 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
     op.geometry_count = info.geometryCount;
     op.first_geometry = static_cast<uint32_t>(geometries_.size());
     const bool has_geometries = info.pGeometries || info.ppGeometries;
+    if (!has_geometries && info.geometryCount != 0) op.geometries_unreadable = true;
     if (has_geometries && info.geometryCount != 0) {
       // Whether the info has ranges is decided once, not per geometry. (No reserve: one of the exact size per
       // info would defeat the vector's geometric growth and copy the whole batch on every call.)
       const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges ? ranges[i] : nullptr;
       for (uint32_t j = 0; j < info.geometryCount; ++j) {
-        GeometryRecord record = MakeGeometryRecord(info.pGeometries ? info.pGeometries[j] : *info.ppGeometries[j]);
+        const VkAccelerationStructureGeometryKHR* geometry =
+            info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+        if (!geometry) {  // every check family guards this; the record must too
+          op.geometries_unreadable = true;
+          geometries_.resize(op.first_geometry);
+          break;
+        }
+        GeometryRecord record = MakeGeometryRecord(*geometry);
         if (info_ranges) {
           record.primitive_count = info_ranges[j].primitiveCount;
           record.primitive_count_known = true;
@@ -128,7 +136,7 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
         geometries_.push_back(record);
       }
     }
-    if (!has_geometries) op.geometry_count = 0;  // nothing to compare (invalid, and another rule's business)
+    if (op.geometries_unreadable || !has_geometries) op.geometry_count = 0;
     ops_.push_back(op);
   }
 }

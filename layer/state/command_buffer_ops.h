@@ -100,6 +100,9 @@ struct AsOp {
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   uint32_t geometry_count = 0;
   uint32_t first_geometry = 0;  // index into the batch's geometries
+  // The geometries could not be read (a null ppGeometries[j], or neither array given with geometryCount > 0):
+  // an invalid build, reported by the structure family; what it leaves in dst is unknown.
+  bool geometries_unreadable = false;
 
   // kCopy, kSerialize, kDeserialize
   VkCopyAccelerationStructureModeKHR copy_mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
@@ -123,6 +126,10 @@ class OpBatch {
 
   // Clears and keeps the capacity.
   void Clear();
+  void Swap(OpBatch& other) noexcept {
+    ops_.swap(other.ops_);
+    geometries_.swap(other.geometries_);
+  }
 
   // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
   void AppendBuilds(const OpOrigin& origin, uint32_t info_count,

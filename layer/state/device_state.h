@@ -9,7 +9,7 @@
 
 #include "address_map.h"
 #include "build_size_cache.h"
-#include "command_buffer_levels.h"
+#include "command_buffers.h"
 #include "concurrent_map.h"
 #include "history_state.h"
 #include "format_features.h"
@@ -41,6 +41,9 @@ class DeviceState {
   // Set once while vkCreateDevice runs, before any other thread can see the device.
   DeviceFeatures features;
   DeviceProperties properties;
+  // The settings enable a family that needs the build history (history, or copies for dst-03561): operations
+  // are recorded and applied only then.
+  bool history_tracked = true;
 
   ConcurrentMap<VkDeviceMemory, std::shared_ptr<const MemoryState>> memories;
   ConcurrentMap<VkBuffer, std::shared_ptr<const BufferState>> buffers;
@@ -54,14 +57,20 @@ class DeviceState {
   BuildSizeCache build_sizes;
   // Host pointers from vkMapMemory (host builds' scratch must fit in what the app mapped).
   HostMappings host_mappings;
-  // Command pools and buffers: level and protected-ness (commandBuffer-09547).
-  CommandBufferLevels command_buffer_levels;
+  // Command pools and buffers: level, protected-ness (commandBuffer-09547), recorded operations.
+  CommandBufferMap command_buffers;
   // Buffer format features, asked of the driver once per format (vertexFormat-03797).
   FormatFeatureCache format_features;
 
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
+
+  // A fresh id, unique on this device (BufferState::id).
+  uint64_t NextObjectId() { return next_object_id_.fetch_add(1, std::memory_order_relaxed) + 1; }
+
+ private:
+  std::atomic<uint64_t> next_object_id_{0};
 };
 
 }  // namespace asval

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#define XXH_INLINE_ALL
+#include <xxhash.h>
+
 namespace asval {
 
 const char* UnknownReasonText(UnknownReason reason) {
@@ -10,29 +13,20 @@ const char* UnknownReasonText(UnknownReason reason) {
     case UnknownReason::kDeserializedUnknownBytes:
       return "deserialized from bytes the layer did not see serialized (or saw modified since)";
     case UnknownReason::kCopiedFromUnknown: return "copied from a structure whose history is unknown";
-    case UnknownReason::kLostOperations: return "the layer could not record some operations";
+    case UnknownReason::kDeserializedDeviceBytes:
+      return "deserialized from device memory, whose bytes the layer cannot verify";
+    case UnknownReason::kLostOperations:
+      return "written by a command buffer the layer did not see recorded, or whose operations it could not record";
+    case UnknownReason::kUnreadableBuild: return "built by an invalid build whose geometries could not be read";
   }
   return "";
 }
 
-uint64_t HashBytes(const void* data, std::size_t size) {
-  uint64_t hash = 0xcbf29ce484222325ULL;
-  const auto* bytes = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) {
-    hash ^= bytes[i];
-    hash *= 0x100000001b3ULL;
-  }
-  return hash;
-}
+uint64_t HashBytes(const void* data, std::size_t size) { return XXH3_64bits(data, size); }
 
 AsHistory HistoryStore::Get(VkAccelerationStructureKHR as) const {
   if (const AsHistory* found = Find(as)) return *found;
-  AsHistory fresh;
-  if (everything_unknown_) {
-    fresh.kind = HistoryKind::kUnknown;
-    fresh.unknown_reason = UnknownReason::kLostOperations;
-  }
-  return fresh;
+  return AsHistory{};
 }
 
 const AsHistory* HistoryStore::Find(VkAccelerationStructureKHR as) const {
@@ -111,14 +105,6 @@ uint64_t HistoryStore::AddBlob(SerializedBlob blob, Transaction* txn) {
   return blob_counter_;
 }
 
-const SerializedBlob* HistoryStore::FindDeviceBlob(const MemorySpan& start) const {
-  if (start.memory == VK_NULL_HANDLE) return nullptr;
-  for (auto it = blobs_.rbegin(); it != blobs_.rend(); ++it) {
-    if (it->valid && it->span.memory == start.memory && it->span.begin == start.begin) return &*it;
-  }
-  return nullptr;
-}
-
 const SerializedBlob* HistoryStore::FindHostBlob(const void* host_address) const {
   if (!host_address) return nullptr;
   for (auto it = blobs_.rbegin(); it != blobs_.rend(); ++it) {
@@ -142,6 +128,18 @@ void HistoryStore::InvalidateBlobsOverlapping(const MemorySpan& span, Transactio
 void HistoryStore::InvalidateHostBlob(const void* host_address, Transaction* txn) {
   for (SerializedBlob& blob : blobs_) {
     if (!blob.valid || blob.host_address != host_address) continue;
+    blob.valid = false;
+    if (txn) {
+      Transaction::Entry entry{Transaction::Kind::kBlobInvalidated};
+      entry.blob_id = blob.id;
+      txn->entries_.push_back(std::move(entry));
+    }
+  }
+}
+
+void HistoryStore::InvalidateAllBlobs(Transaction* txn) {
+  for (SerializedBlob& blob : blobs_) {
+    if (!blob.valid) continue;
     blob.valid = false;
     if (txn) {
       Transaction::Entry entry{Transaction::Kind::kBlobInvalidated};
@@ -179,16 +177,16 @@ void HistoryStore::ForgetPool(VkQueryPool pool) {
   }
 }
 
-void HistoryStore::MarkEverythingUnknown() {
-  everything_unknown_ = true;
-  for (auto& [as, record] : histories_) {
-    record.history.kind = HistoryKind::kUnknown;
-    record.history.unknown_reason = UnknownReason::kLostOperations;
-    record.history.build.reset();
-    record.version = ++version_counter_;
+void HistoryStore::ForgetMemory(VkDeviceMemory memory) {
+  blobs_.erase(std::remove_if(blobs_.begin(), blobs_.end(),
+                              [memory](const SerializedBlob& b) { return b.span.memory == memory; }),
+               blobs_.end());
+  auto it = spans_.lower_bound(SpanKey{memory, 0});
+  while (it != spans_.end() && it->first.memory == memory) {
+    if (auto h = histories_.find(it->second.as); h != histories_.end()) h->second.history.span = MemorySpan{};
+    it = spans_.erase(it);
   }
-  for (SerializedBlob& blob : blobs_) blob.valid = false;
-  structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+  longest_span_.erase(memory);
 }
 
 void HistoryStore::Undo(Transaction& txn) {

@@ -29,6 +29,9 @@
 
 namespace asval {
 
+// XXH3 (64 bits) over bytes: serialized data read back on the host, and small keys.
+uint64_t HashBytes(const void* data, std::size_t size);
+
 // What an update must repeat (VUIDs 03667, 03758..03767, 03769): the parameters of the last build.
 // Immutable and shared: a clone or compaction shares its source's snapshot.
 struct BuildSnapshot {
@@ -43,8 +46,10 @@ enum class HistoryKind : uint8_t { kNeverBuilt, kBuilt, kUnknown };
 enum class UnknownReason : uint8_t {
   kNone,
   kDeserializedUnknownBytes,  // the bytes were not serialized by a command the layer saw, or were modified since
+  kDeserializedDeviceBytes,   // deserialized from device memory, whose bytes the layer cannot verify (yet)
   kCopiedFromUnknown,         // cloned, compacted or deserialized from a structure whose history is unknown
   kLostOperations,            // the layer could not record an operation (allocation failure) or a command buffer
+  kUnreadableBuild,           // built by an invalid build whose geometries could not be read
 };
 const char* UnknownReasonText(UnknownReason reason);
 
@@ -119,7 +124,7 @@ class HistoryStore {
 
   // ---- everything below: with Lock() held ----
 
-  // The record of a structure; never built when the layer has none (unknown after a lost operation).
+  // The record of a structure; never built when the layer has none.
   AsHistory Get(VkAccelerationStructureKHR as) const;
   const AsHistory* Find(VkAccelerationStructureKHR as) const;
   // Replaces the record (and indexes its span). txn may be null (host operations are not rolled back).
@@ -134,19 +139,19 @@ class HistoryStore {
 
   // Serialized bytes.
   uint64_t AddBlob(SerializedBlob blob, Transaction* txn);
-  // The valid device blob starting exactly at span.begin of span.memory, or null.
-  const SerializedBlob* FindDeviceBlob(const MemorySpan& start) const;
   const SerializedBlob* FindHostBlob(const void* host_address) const;
   void InvalidateBlobsOverlapping(const MemorySpan& span, Transaction* txn);
   void InvalidateHostBlob(const void* host_address, Transaction* txn);
+  void InvalidateAllBlobs(Transaction* txn);
 
   // Query slots.
   void SetSlot(VkQueryPool pool, uint32_t query, const QuerySlot& slot, Transaction* txn);
   const QuerySlot* FindSlot(VkQueryPool pool, uint32_t query) const;
   void ForgetPool(VkQueryPool pool);
 
-  // Every structure's history becomes unknown (a command buffer whose operations were lost was submitted).
-  void MarkEverythingUnknown();
+  // vkFreeMemory: serialized bytes in that memory are gone, and spans there index nothing any more (a later
+  // allocation may reuse the handle value). Not part of any transaction: freeing memory is not undone.
+  void ForgetMemory(VkDeviceMemory memory);
 
   // Rolls a transaction back. Entries that a later change already replaced are left alone.
   void Undo(Transaction& txn);
@@ -176,7 +181,8 @@ class HistoryStore {
   };
   struct SlotKeyHash {
     std::size_t operator()(const std::pair<VkQueryPool, uint32_t>& k) const noexcept {
-      return HandleHash<VkQueryPool>{}(k.first) ^ (static_cast<std::size_t>(k.second) * 0x9e3779b97f4a7c15ULL);
+      const uint64_t words[2] = {reinterpret_cast<uint64_t>(k.first), k.second};
+      return static_cast<std::size_t>(HashBytes(words, sizeof(words)));
     }
   };
   struct SlotRecord {
@@ -196,7 +202,6 @@ class HistoryStore {
   uint64_t generation_counter_ = 0;
   uint64_t version_counter_ = 0;
   uint64_t blob_counter_ = 0;
-  bool everything_unknown_ = false;
 };
 
 template <typename F>
@@ -210,8 +215,5 @@ void HistoryStore::ForEachOverlapping(const MemorySpan& span, VkAccelerationStru
     if (it->second.end > span.begin && it->second.as != except) f(it->second.as);
   }
 }
-
-// FNV-1a over host bytes (serialized data read back on the host).
-uint64_t HashBytes(const void* data, std::size_t size);
 
 }  // namespace asval

@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "structure_memory.h"
+
 namespace asval {
 
 namespace {
@@ -111,6 +113,12 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
   std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
   AsHistory& h = *fresh;
+  if (op.geometries_unreadable) {
+    h.kind = HistoryKind::kUnknown;
+    h.unknown_reason = UnknownReason::kUnreadableBuild;
+    SetWritten(store, op.dst, std::move(h), op, txn);
+    return;
+  }
   h.kind = HistoryKind::kBuilt;
   if (op.is_update()) {
     const AsHistory* src = store.Find(op.src);
@@ -174,22 +182,25 @@ void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp&
   if (!fresh) return;
   AsHistory& h = *fresh;
   const SerializedBlob* blob = nullptr;
+  // Only host bytes can be trusted to be what the layer saw serialized, by their hash: device memory may have
+  // been rewritten by commands the layer does not follow (vkCmdCopyBuffer, vkCmdUpdateBuffer, vkCmdFillBuffer,
+  // copies from images, shader writes), by the host through a mapping, or freed and reallocated.
+  // TODO(capture issue): verify device bytes by content when they are captured at execution time.
   if (op.memory.host_address) {
     const SerializedBlob* candidate = store.FindHostBlob(op.memory.host_address);
-    // Host bytes may have been rewritten by the app without the layer seeing it: compare them.
     if (candidate && SerializedHostSize(op.memory.host_address) == candidate->host_size &&
         HashBytes(op.memory.host_address, candidate->host_size) == candidate->host_hash) {
       blob = candidate;
     }
-  } else {
-    blob = store.FindDeviceBlob(op.memory.span);
   }
   if (blob && blob->history.kind == HistoryKind::kBuilt) {
     h.kind = HistoryKind::kBuilt;
     h.build = blob->history.build;
   } else {
     h.kind = HistoryKind::kUnknown;
-    h.unknown_reason = blob ? UnknownReason::kCopiedFromUnknown : UnknownReason::kDeserializedUnknownBytes;
+    h.unknown_reason = blob                  ? UnknownReason::kCopiedFromUnknown
+                       : op.memory.host_address ? UnknownReason::kDeserializedUnknownBytes
+                                                : UnknownReason::kDeserializedDeviceBytes;
   }
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
@@ -203,12 +214,23 @@ void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn)
 }  // namespace
 
 std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as) {
-  std::optional<std::shared_ptr<const AccelerationStructureState>> record = state.acceleration_structures.find(as);
-  if (!record || !*record) return std::nullopt;
-  std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find((*record)->buffer);
-  if (!buffer || !*buffer || !(*buffer)->bound) return std::nullopt;
-  const MemoryBinding binding{(*buffer)->memory, (*buffer)->memory_offset, true};
-  return ResolveMemorySpan(binding, (*record)->offset, (*record)->size);
+  const std::optional<StructureMemory> memory = MemoryOfStructure(state, as);
+  return memory ? memory->Span() : std::nullopt;
+}
+
+void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Transaction* txn) {
+  // The structures that exist now: one created later cannot have been written by this command buffer.
+  const auto live = state.acceleration_structures.snapshot();
+  for (const auto& [as, record] : live) {
+    std::optional<AsHistory> fresh = Fresh(state, store, as);
+    if (!fresh) continue;
+    fresh->kind = HistoryKind::kUnknown;
+    fresh->unknown_reason = UnknownReason::kLostOperations;
+    store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+    store.Set(as, std::move(*fresh), txn);
+  }
+  // Any serialized bytes may have been overwritten.
+  store.InvalidateAllBlobs(txn);
 }
 
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn) {

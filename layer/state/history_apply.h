@@ -17,6 +17,10 @@ std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, Vk
 // changes so that a skipped or failed submission can be rolled back.
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn);
 
+// A command buffer the layer never saw allocated, or whose operations it could not record, was submitted:
+// every structure that exists now gets an unknown history (undone with the submission, through txn).
+void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Transaction* txn);
+
 // Serialization sizes read back on the host (vkWriteAccelerationStructuresPropertiesKHR, or a query result
 // fetched with vkGetQueryPoolResults) for the structure's current contents.
 void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size);

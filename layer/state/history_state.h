@@ -1,6 +1,7 @@
 #pragma once
-// What the history rules keep per device: command-buffer operation logs, the structures' histories (with
-// serialized bytes and property-query slots), the query pools, and host operations still deferred.
+// What the history rules keep per device: the structures' histories (with serialized bytes and property-query
+// slots), the query pools, host operations still deferred, and the order of submissions. (The operations each
+// command buffer records are in command_buffers.h.)
 #include <vulkan/vulkan.h>
 
 #include <memory>
@@ -8,7 +9,6 @@
 #include <unordered_map>
 
 #include "command_buffer_ops.h"
-#include "command_buffer_ops_tracker.h"
 #include "concurrent_map.h"
 #include "history.h"
 
@@ -25,13 +25,17 @@ struct DeferredHostOps {
 };
 
 struct HistoryState {
-  CommandBufferTracker command_buffers;
   HistoryStore store;
+  // Held by a submission that changes histories from before it applies them until its downcall returned (and
+  // its changes were undone, if the driver rejected it): a submission on another queue waits, so it is never
+  // checked against changes of a submission that did not happen. Recursive: an app callback that reports a
+  // finding of the submission may itself submit on this thread. Taken before store's lock, never after.
+  std::recursive_mutex submission_order;
   ConcurrentMap<VkQueryPool, QueryPoolState> query_pools;
 
   // Deferred host operations (vkBuildAccelerationStructuresKHR and the host copies with a deferredOperation
   // that returned VK_OPERATION_DEFERRED_KHR). Guarded by deferred_mutex.
-  std::mutex deferred_mutex;
+  mutable std::mutex deferred_mutex;
   std::unordered_map<VkDeferredOperationKHR, std::unique_ptr<DeferredHostOps>, HandleHash<VkDeferredOperationKHR>>
       deferred;
 };

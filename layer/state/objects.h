@@ -21,6 +21,9 @@ struct MemoryState {
 
 struct BufferState {
   VkBuffer handle = VK_NULL_HANDLE;
+  // Unique per device for the buffer's lifetime (handle values are reused after vkDestroyBuffer): what a
+  // structure holds to know that the buffer it finds under its handle is still the one it was created on.
+  uint64_t id = 0;
   VkDeviceSize size = 0;
   VkBufferUsageFlags usage = 0;
   VkBufferCreateFlags create_flags = 0;
@@ -28,6 +31,8 @@ struct BufferState {
   bool bound = false;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkDeviceSize memory_offset = 0;
+  // The memory it was bound to was freed (memory is then VK_NULL_HANDLE: the handle value may be reused).
+  bool memory_freed = false;
   // Queried by the layer itself at bind time when the usage has SHADER_DEVICE_ADDRESS; 0 otherwise.
   VkDeviceAddress device_address = 0;
 
@@ -37,6 +42,7 @@ struct BufferState {
 struct AccelerationStructureState {
   VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
   VkBuffer buffer = VK_NULL_HANDLE;
+  uint64_t buffer_id = 0;  // BufferState::id of that buffer when the structure was created (0: unknown buffer)
   VkDeviceSize offset = 0;
   VkDeviceSize size = 0;
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR;

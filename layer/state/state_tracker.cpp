@@ -41,11 +41,28 @@ void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, 
 void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
   state.memories.erase(memory);
   state.host_mappings.Unmap(memory);  // freeing unmaps
+  // Buffers bound to it keep their binding (it never goes away) but no longer have bytes or a usable device
+  // address: their ranges leave the address map, so that a buffer later given the same addresses in another
+  // allocation is the only one a lookup finds, and their records forget the memory's handle value.
+  const auto bound = state.buffers.snapshot([memory](VkBuffer, const std::shared_ptr<const BufferState>& b) {
+    return b && b->bound && b->memory == memory;
+  });
+  for (const auto& [handle, old] : bound) {
+    if (old->device_address != 0) state.buffer_addresses.Erase(old->device_address, handle);
+    auto record = std::make_shared<BufferState>(*old);
+    record->memory = VK_NULL_HANDLE;
+    record->memory_freed = true;
+    record->device_address = 0;
+    state.buffers.insert_or_assign(handle, std::move(record));
+  }
+  std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  state.history.store.ForgetMemory(memory);
 }
 
 void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer) {
   auto record = std::make_shared<BufferState>();
   record->handle = buffer;
+  record->id = state.NextObjectId();
   record->size = info.size;
   record->usage = info.usage;
   if (auto* usage2 = FindInChain<BufferUsageFlags2CreateInfo>(info.pNext, kBufferUsageFlags2CreateInfo)) {
@@ -94,6 +111,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   // The layer asks for the address only where the app itself could (the buffer is bound and has
   // SHADER_DEVICE_ADDRESS usage), so that its own call breaks no rule.
   std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(info.buffer);
+  if (buffer && *buffer) record->buffer_id = (*buffer)->id;
   record->buffer_was_bound = buffer && *buffer && (*buffer)->bound;
   if (buffer && *buffer && (*buffer)->bound && ((*buffer)->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) &&
       dispatch.GetAccelerationStructureDeviceAddressKHR) {
@@ -106,6 +124,33 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
 
 void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
   state.acceleration_structures.erase(handle);
+  std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  state.history.store.Forget(handle);
+}
+
+void RecordMapMemory(DeviceState& state, VkDeviceMemory memory, VkDeviceSize offset, VkDeviceSize size,
+                     void* host_address) {
+  VkDeviceSize bytes = size;
+  if (size == VK_WHOLE_SIZE) {
+    const std::optional<std::shared_ptr<const MemoryState>> record = state.memories.find(memory);
+    if (!record || !*record || (*record)->size < offset) return;  // extent unknown: not recorded
+    bytes = (*record)->size - offset;
+  }
+  state.host_mappings.Map(memory, offset, bytes, host_address);
+}
+
+void RecordUnmapMemory(DeviceState& state, VkDeviceMemory memory) { state.host_mappings.Unmap(memory); }
+
+void RecordCreateQueryPool(DeviceState& state, const VkQueryPoolCreateInfo& info, VkQueryPool pool) {
+  state.history.query_pools.insert_or_assign(pool, QueryPoolState{info.queryType, info.queryCount});
+}
+
+void RecordDestroyQueryPool(DeviceState& state, VkQueryPool pool) {
+  std::optional<QueryPoolState> record = state.history.query_pools.pop(pool);
+  if (record && record->type == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) {
+    std::unique_lock<std::mutex> lock = state.history.store.Lock();
+    state.history.store.ForgetPool(pool);
+  }
 }
 
 DeviceFeatures ParseEnabledFeatures(const VkDeviceCreateInfo& info) {

@@ -4,15 +4,19 @@
 // store's undo, clobber and lost-operation behaviour.
 #include <catch2/catch_test_macros.hpp>
 
+#include <atomic>
 #include <chrono>
+#include <thread>
 #include <cstdio>
 #include <cstring>
 
 #include "build_command.h"
 #include "copies.h"
 #include "history_apply.h"
-#include "history_record.h"
-#include "history_submit.h"
+#include "history_host.h"
+#include "history_recorder.h"
+#include "submission.h"
+#include "submit_checks.h"
 #include "layer_settings.h"
 #include "state_tracker.h"
 #include "update_rules.h"
@@ -156,6 +160,20 @@ TEST_CASE("history unit: indirect updates check everything but the primitive cou
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&direct})).empty());
 }
 
+TEST_CASE("history unit: an indirect update that differs in a geometry counts each unknown count once",
+          "[history]") {
+  World w;
+  const Build build(w.a, {3, 4}, kUpdatable);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
+  Build changed(w.a, {3, 4}, kUpdatable, w.a);
+  changed.geometries[1].geometry.triangles.vertexFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+  const uint64_t skipped = w.state.history.store.rules_skipped_unknown_history.load();
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuildIndirect, {&changed})) ==
+        std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03763"});
+  // Two geometries whose counts are on the device: two skips (it used to be three, the first counted twice).
+  CHECK(w.state.history.store.rules_skipped_unknown_history.load() == skipped + 2);
+}
+
 TEST_CASE("history unit: indirect updates of a source never built, or built without ALLOW_UPDATE, fire 03667",
           "[history]") {
   World w;
@@ -178,7 +196,7 @@ TEST_CASE("history unit: host builds are checked when called (valid twin silent,
   host.infos = &build.info;
   host.ranges = &build.range_pointer;
   CHECK_FALSE(ValidateBuildHistory(ctx, host));
-  FinishHostBuild(w.state, kAll, host, VK_SUCCESS);
+  FinishHostOps(w.state, HostBuildOps(host.info_count, host.infos, host.ranges), host.deferred_operation, VK_SUCCESS);
   // Valid twin: an update repeating the host build.
   const Build update(w.a, {2}, kUpdatable, w.a);
   host.infos = &update.info;
@@ -210,7 +228,7 @@ TEST_CASE("history unit: a deferred host build changes the history only once it 
   host.info_count = 1;
   host.infos = &build.info;
   host.ranges = &build.range_pointer;
-  FinishHostBuild(w.state, kAll, host, VK_OPERATION_DEFERRED_KHR);
+  FinishHostOps(w.state, HostBuildOps(host.info_count, host.infos, host.ranges), host.deferred_operation, VK_OPERATION_DEFERRED_KHR);
   {
     auto lock = w.state.history.store.Lock();
     CHECK(w.state.history.store.Get(w.a).kind == HistoryKind::kNeverBuilt);
@@ -225,7 +243,7 @@ TEST_CASE("history unit: a deferred host build changes the history only once it 
   const Build other(w.b, {1}, kUpdatable);
   host.infos = &other.info;
   host.ranges = &other.range_pointer;
-  FinishHostBuild(w.state, kAll, host, VK_OPERATION_DEFERRED_KHR);
+  FinishHostOps(w.state, HostBuildOps(host.info_count, host.infos, host.ranges), host.deferred_operation, VK_OPERATION_DEFERRED_KHR);
   CompleteDeferredOps(w.state, deferred, VK_ERROR_OUT_OF_HOST_MEMORY);
   lock.lock();
   CHECK(w.state.history.store.Get(w.b).kind == HistoryKind::kNeverBuilt);
@@ -238,18 +256,18 @@ TEST_CASE("history unit: host copies and property writes are checked when called
   copy.src = w.a;
   copy.dst = w.b;
   copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR;
-  CHECK_FALSE(CheckHostOps(w.state, reporter, kAll, HostCopyOps(copy), "vkCopyAccelerationStructureKHR"));
+  CHECK_FALSE(ValidateHostOps(CheckContext{w.state, reporter, kAll}, HostCopyOps(copy), "vkCopyAccelerationStructureKHR"));
   CHECK(reporter.ErrorCount() == 1);  // src-04963: a never built
   const Build build(w.a, {1}, kUpdatable | VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
   // Valid twins: the compaction of a compactable structure and its property query.
-  CHECK_FALSE(CheckHostOps(w.state, reporter, kAll, HostCopyOps(copy), "vkCopyAccelerationStructureKHR"));
+  CHECK_FALSE(ValidateHostOps(CheckContext{w.state, reporter, kAll}, HostCopyOps(copy), "vkCopyAccelerationStructureKHR"));
   const VkAccelerationStructureKHR structures[] = {w.a};
   const OpBatch query =
       HostWritePropertiesOps(1, structures, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR);
-  CHECK_FALSE(CheckHostOps(w.state, reporter, kAll, query, "vkWriteAccelerationStructuresPropertiesKHR"));
+  CHECK_FALSE(ValidateHostOps(CheckContext{w.state, reporter, kAll}, query, "vkWriteAccelerationStructuresPropertiesKHR"));
   CHECK(reporter.ErrorCount() == 1);
-  FinishHostOps(w.state, kAll, HostCopyOps(copy), VK_NULL_HANDLE, VK_SUCCESS);
+  FinishHostOps(w.state, HostCopyOps(copy), VK_NULL_HANDLE, VK_SUCCESS);
   // The compacted copy updates like its source.
   const Build update(w.b, {1}, kUpdatable | VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR, w.b);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&update})).empty());
@@ -267,18 +285,18 @@ TEST_CASE("history unit: host serialization restores history only from unmodifie
   to.src = w.a;
   to.dst.hostAddress = bytes.data();
   to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
-  FinishHostOps(w.state, kAll, HostCopyToMemoryOps(to), VK_NULL_HANDLE, VK_SUCCESS);
+  FinishHostOps(w.state, HostCopyToMemoryOps(to), VK_NULL_HANDLE, VK_SUCCESS);
   VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
   from.src.hostAddress = bytes.data();
   from.dst = w.b;
   from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
-  FinishHostOps(w.state, kAll, HostCopyMemoryToOps(from), VK_NULL_HANDLE, VK_SUCCESS);
+  FinishHostOps(w.state, HostCopyMemoryToOps(from), VK_NULL_HANDLE, VK_SUCCESS);
   const Build mismatch(w.b, {2, 2}, kUpdatable, w.b);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&mismatch})) ==
         std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758"});
   // The app rewrites the bytes (as when loading another blob into the same memory): unknown, silent, counted.
   bytes[100] ^= 1;
-  FinishHostOps(w.state, kAll, HostCopyMemoryToOps(from), VK_NULL_HANDLE, VK_SUCCESS);
+  FinishHostOps(w.state, HostCopyMemoryToOps(from), VK_NULL_HANDLE, VK_SUCCESS);
   const uint64_t skipped = w.state.history.store.rules_skipped_unknown_history.load();
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&mismatch})).empty());
   CHECK(w.state.history.store.rules_skipped_unknown_history.load() == skipped + 1);
@@ -292,8 +310,9 @@ TEST_CASE("history unit: a build over another structure's memory clobbers it; a 
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&update_b, &update_a})) ==
         std::vector<std::string>{"ASVAL-History-Clobbered"});
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&a, &update_a})).empty());
-  // Destroyed: the history ends; an update of a structure with the same handle finds it never built.
-  ForgetHistory(w.state, w.a);
+  // Destroyed: the history ends; an update of a new structure with the same handle finds it never built.
+  RecordDestroyAccelerationStructure(w.state, w.a);
+  w.Structure(w.a, Fake<VkBuffer>(2), 0);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&update_a})) ==
         std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03667"});
 }
@@ -323,51 +342,216 @@ TEST_CASE("history unit: undo restores what a skipped submission changed, but no
   }
 }
 
-TEST_CASE("history unit: a lost command buffer makes every history unknown", "[history]") {
+// Submits `cbs` the way the vkQueueSubmit hook does; returns true when findings were reported.
+struct Submitted {
+  bool reported = false;
+  uint64_t ops = 0;
+};
+Submitted SubmitCommandBuffers(World& w, Reporter& reporter, std::initializer_list<VkCommandBuffer> cbs,
+                               VkResult driver_result = VK_SUCCESS) {
+  const CheckContext ctx{w.state, reporter, kAll};
+  HistorySubmission submission(w.state);
+  SubmitChecks checks(ctx);
+  for (VkCommandBuffer cb : cbs) submission.Apply(cb, checks.For(cb, Location("vkQueueSubmit")));
+  submission.EndApply();
+  Submitted out;
+  out.reported = checks.ReportAll();
+  if (driver_result != VK_SUCCESS) submission.Undo();
+  out.ops = submission.ops_applied();
+  return out;
+}
+
+TEST_CASE("history unit: a submission on another queue waits for a rejected one, and is checked without it",
+          "[history][threads]") {
+  World w;
+  Reporter reporter(ReportSettings{});
+  CommandBufferMap& map = w.state.command_buffers;
+  const VkCommandPool pool = Fake<VkCommandPool>(3);
+  const VkCommandBuffer rebuild = Fake<VkCommandBuffer>(100), update = Fake<VkCommandBuffer>(101);
+  const VkCommandBuffer both[] = {rebuild, update};
+  map.CreatePool(pool, 0);
+  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
+               both);
+  // Executed: a with one geometry. Queue 1 rebuilds it with two, and the driver rejects that submission;
+  // queue 2, meanwhile, updates it with one geometry: valid, because the rebuild never happened.
+  const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), update_one(w.a, {1}, kUpdatable, w.a);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&one})).empty());
+  map.Reset(rebuild);
+  RecordCmdBuild(w.state, rebuild, OpCommand::kCmdBuild, 1, &two.info, &two.range_pointer);
+  map.End(rebuild);
+  map.Reset(update);
+  RecordCmdBuild(w.state, update, OpCommand::kCmdBuild, 1, &update_one.info, &update_one.range_pointer);
+  map.End(update);
+
+  std::atomic<bool> in_downcall{false};
+  bool second_reported = true;
+  std::thread queue1([&] {
+    const CheckContext ctx{w.state, reporter, kAll};
+    HistorySubmission submission(w.state);
+    SubmitChecks checks(ctx);
+    submission.Apply(rebuild, checks.For(rebuild, Location("vkQueueSubmit")));
+    submission.EndApply();
+    CHECK_FALSE(checks.ReportAll());
+    in_downcall = true;
+    // The driver takes its time, then rejects the submission.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    submission.Undo();
+  });
+  std::thread queue2([&] {
+    while (!in_downcall) std::this_thread::yield();
+    second_reported = SubmitCommandBuffers(w, reporter, {update}).reported;
+  });
+  queue1.join();
+  queue2.join();
+  CHECK_FALSE(second_reported);
+  CHECK(reporter.ErrorCount() == 0);
+  auto lock = w.state.history.store.Lock();
+  REQUIRE(w.state.history.store.Get(w.a).build);
+  CHECK(w.state.history.store.Get(w.a).build->geometries.size() == 1);
+}
+
+TEST_CASE("history unit: a lost command buffer makes the histories of the structures that exist unknown",
+          "[history]") {
   World w;
   Reporter reporter(ReportSettings{});
   const Build build(w.a, {1}, kUpdatable);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
-  SubmitHistory submit(w.state, reporter, kAll);
-  submit.Apply(Fake<VkCommandBuffer>(999), Location("vkQueueSubmit"));  // never seen allocated
-  CHECK_FALSE(submit.Finish());
-  auto lock = w.state.history.store.Lock();
-  CHECK(w.state.history.store.Get(w.a).kind == HistoryKind::kUnknown);
-  CHECK(w.state.history.store.Get(w.b).kind == HistoryKind::kUnknown);
+  SubmitCommandBuffers(w, reporter, {Fake<VkCommandBuffer>(999)});  // never seen allocated
+  {
+    auto lock = w.state.history.store.Lock();
+    CHECK(w.state.history.store.Get(w.a).kind == HistoryKind::kUnknown);
+    CHECK(w.state.history.store.Get(w.b).kind == HistoryKind::kUnknown);
+  }
+  // A structure created afterwards cannot have been written by that command buffer: it starts never built,
+  // so an update of it is still found (before the fix it stayed unknown forever and the rule was skipped).
+  const VkAccelerationStructureKHR later = Fake<VkAccelerationStructureKHR>(13);
+  w.Structure(later, Fake<VkBuffer>(6), 2 << 20);
+  const Build update_later(later, {1}, kUpdatable, later);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&update_later})) ==
+        std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03667"});
 }
 
-TEST_CASE("history unit: command-buffer logs follow allocation, secondaries, resets and frees", "[history]") {
+TEST_CASE("history unit: an unknown command buffer in a rejected submission changes nothing", "[history]") {
   World w;
   Reporter reporter(ReportSettings{});
-  CommandBufferTracker& tracker = w.state.history.command_buffers;
+  const Build build(w.a, {1, 1}, kUpdatable);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
+  SubmitCommandBuffers(w, reporter, {Fake<VkCommandBuffer>(999)}, VK_ERROR_DEVICE_LOST);
+  auto lock = w.state.history.store.Lock();
+  REQUIRE(w.state.history.store.Get(w.a).kind == HistoryKind::kBuilt);
+  CHECK(w.state.history.store.Get(w.a).build->geometries.size() == 2);
+  CHECK(w.state.history.store.Get(w.b).kind == HistoryKind::kNeverBuilt);
+}
+
+TEST_CASE("history unit: a null ppGeometries element is recorded without a crash and leaves dst unknown",
+          "[history]") {
+  World w;
+  const Build build(w.a, {1, 1}, kUpdatable);
+  const VkAccelerationStructureGeometryKHR* pointers[] = {&build.geometries[0], nullptr};
+  VkAccelerationStructureBuildGeometryInfoKHR info = build.info;
+  info.pGeometries = nullptr;
+  info.ppGeometries = pointers;
+  OpBatch batch;
+  batch.AppendBuilds(Origin(OpCommand::kCmdBuild), 1, &info, &build.range_pointer);
+  REQUIRE(batch.ops().size() == 1);
+  CHECK(batch.ops()[0].geometries_unreadable);
+  CHECK(batch.geometries().empty());
+  CHECK(Execute(w, batch).empty());
+  {
+    auto lock = w.state.history.store.Lock();
+    CHECK(w.state.history.store.Get(w.a).kind == HistoryKind::kUnknown);
+  }
+  // As an update: the source's history is known, the geometries are not; the comparison is skipped, counted.
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
+  VkAccelerationStructureBuildGeometryInfoKHR update = info;
+  update.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+  update.srcAccelerationStructure = w.a;
+  OpBatch updates;
+  updates.AppendBuilds(Origin(OpCommand::kCmdBuild), 1, &update, &build.range_pointer);
+  const uint64_t skipped = w.state.history.store.rules_skipped_unknown_history.load();
+  CHECK(Execute(w, updates).empty());
+  CHECK(w.state.history.store.rules_skipped_unknown_history.load() == skipped + 1);
+}
+
+TEST_CASE("history unit: command-buffer states follow allocation, secondaries, resets and frees", "[history]") {
+  World w;
+  CommandBufferMap& map = w.state.command_buffers;
   const VkCommandPool pool = Fake<VkCommandPool>(3);
   const VkCommandBuffer cbs[] = {Fake<VkCommandBuffer>(100), Fake<VkCommandBuffer>(101)};
-  tracker.Allocate(pool, 2, cbs);
+  map.CreatePool(pool, 0);
+  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
+               cbs);
   const Build build(w.a, {1}, kUpdatable);
-  BuildCommand cmd{BuildCommandKind::kCmdBuild, "vkCmdBuildAccelerationStructuresKHR"};
-  cmd.command_buffer = cbs[1];  // the secondary
-  cmd.info_count = 1;
-  cmd.infos = &build.info;
-  cmd.ranges = &build.range_pointer;
-  RecordDeviceBuild(w.state, kAll, cmd);
-  RecordExecuteCommands(w.state, kAll, cbs[0], 1, &cbs[1]);
-  REQUIRE(tracker.Find(cbs[0])->batch.ops().size() == 1);
-  CHECK(tracker.Find(cbs[0])->batch.ops()[0].origin.executed_by == cbs[0]);
+  map.Reset(cbs[1]);  // the secondary
+  RecordCmdBuild(w.state, cbs[1], OpCommand::kCmdBuild, 1, &build.info, &build.range_pointer);
+  // Not ended yet: a primary executing it (invalid) or a submission sees no operations.
+  CHECK_FALSE(map.Find(cbs[1])->Executable());
+  map.End(cbs[1]);
+  map.Reset(cbs[0]);
+  RecordExecuteCommands(w.state, cbs[0], 1, &cbs[1]);
+  map.End(cbs[0]);
+  REQUIRE(map.Find(cbs[0])->Executable());
+  REQUIRE(map.Find(cbs[0])->Executable()->batch.ops().size() == 1);
+  CHECK(map.Find(cbs[0])->Executable()->batch.ops()[0].origin.executed_by == cbs[0]);
+  CHECK(map.Find(cbs[0])->secondaries == std::vector<VkCommandBuffer>{cbs[1]});
   // Nothing is recorded when both history and copies are disabled.
-  RecordDeviceBuild(w.state, kCheckAlignment, cmd);
-  CHECK(tracker.Find(cbs[1])->batch.ops().size() == 1);
-  tracker.ResetPool(pool);
-  CHECK(tracker.Find(cbs[0])->batch.empty());
-  tracker.Free(1, &cbs[0]);
-  CHECK_FALSE(tracker.Find(cbs[0]));
-  tracker.DestroyPool(pool);
-  CHECK_FALSE(tracker.Find(cbs[1]));
-  CHECK(tracker.size() == 0);
+  w.state.history_tracked = false;
+  map.Reset(cbs[1]);
+  RecordCmdBuild(w.state, cbs[1], OpCommand::kCmdBuild, 1, &build.info, &build.range_pointer);
+  map.End(cbs[1]);
+  CHECK_FALSE(map.Find(cbs[1])->Executable());
+  w.state.history_tracked = true;
+  map.ResetPool(pool);
+  CHECK_FALSE(map.Find(cbs[0])->Executable());
+  map.Free(1, &cbs[0]);
+  CHECK_FALSE(map.Find(cbs[0]));
+  map.DestroyPool(pool);
+  CHECK_FALSE(map.Find(cbs[1]));
+  CHECK(map.size() == 0);
+}
+
+TEST_CASE("history unit: a primary takes a secondary's last completed recording, not one in progress",
+          "[history]") {
+  World w;
+  CommandBufferMap& map = w.state.command_buffers;
+  const VkCommandPool pool = Fake<VkCommandPool>(3);
+  const VkCommandBuffer primary = Fake<VkCommandBuffer>(100), secondary = Fake<VkCommandBuffer>(101);
+  map.CreatePool(pool, 0);
+  const VkCommandBuffer both[] = {primary, secondary};
+  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
+               both);
+  const Build of_a(w.a, {1}, kUpdatable), of_b(w.b, {1}, kUpdatable);
+  map.Reset(secondary);
+  RecordCmdBuild(w.state, secondary, OpCommand::kCmdBuild, 1, &of_a.info, &of_a.range_pointer);
+  map.End(secondary);
+  // Another thread begins re-recording the secondary while this one executes it (pCommandBuffers of
+  // vkCmdExecuteCommands is not externally synchronized): the primary must not read the half-made recording.
+  map.Reset(secondary);
+  RecordCmdBuild(w.state, secondary, OpCommand::kCmdBuild, 1, &of_b.info, &of_b.range_pointer);
+  map.Reset(primary);
+  RecordExecuteCommands(w.state, primary, 1, &secondary);
+  map.End(primary);
+  // The secondary was being re-recorded: nothing completed to take (the earlier recording was reset away).
+  CHECK_FALSE(map.Find(primary)->Executable());
+  map.End(secondary);
+  map.Reset(primary);
+  RecordExecuteCommands(w.state, primary, 1, &secondary);
+  map.End(primary);
+  REQUIRE(map.Find(primary)->Executable());
+  REQUIRE(map.Find(primary)->Executable()->batch.ops().size() == 1);
+  CHECK(map.Find(primary)->Executable()->batch.ops()[0].dst == w.b);
 }
 
 TEST_CASE("history unit: serialization sizes read back attach to the contents they were queried for", "[history]") {
   World w;
   const VkQueryPool pool = Fake<VkQueryPool>(8);
+  VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  pool_info.queryType = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR;
+  pool_info.queryCount = 4;
+  RecordCreateQueryPool(w.state, pool_info, pool);
   const Build build(w.a, {1}, kUpdatable);
   OpBatch batch = Builds(OpCommand::kCmdBuild, {&build});
   AsOp query;
@@ -433,7 +617,7 @@ TEST_CASE("copies unit: host property queries and copies with valid arguments st
 }
 
 // Not run by default ([.]): the submission-time cost behind docs/performance.md. Run it alone, optionally
-// under callgrind with --toggle-collect='*SubmitHistory*' to count only the layer's submission work:
+// under callgrind with --toggle-collect='*HistorySubmission*' to count only the layer's submission work:
 //   asval_unit_tests "[.history-bench]"
 TEST_CASE("history bench: operations applied per second at submission", "[.history-bench]") {
   struct Scenario {
@@ -454,42 +638,36 @@ TEST_CASE("history bench: operations applied per second at submission", "[.histo
     Reporter reporter(ReportSettings{});
     const VkCommandPool pool = Fake<VkCommandPool>(3);
     const VkCommandBuffer cb = Fake<VkCommandBuffer>(100);
-    w.state.history.command_buffers.Allocate(pool, 1, &cb);
+    w.state.command_buffers.CreatePool(pool, 0);
+    w.state.command_buffers.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+                                                                 nullptr, pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1},
+                                     &cb);
+    w.state.command_buffers.Reset(cb);
     std::vector<Build> builds;
     builds.reserve(sc.structures * 2);
     for (VkAccelerationStructureKHR as : handles) builds.emplace_back(as, std::vector<uint32_t>{4, 4}, kUpdatable);
-    BuildCommand cmd{BuildCommandKind::kCmdBuild, "vkCmdBuildAccelerationStructuresKHR"};
-    cmd.command_buffer = cb;
     for (const Build& b : builds) {  // the first build of each, so that updates have a source
-      cmd.info_count = 1;
-      cmd.infos = &b.info;
-      cmd.ranges = &b.range_pointer;
-      RecordDeviceBuild(w.state, kAll, cmd);
+      RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &b.info, &b.range_pointer);
     }
-    {
-      SubmitHistory first(w.state, reporter, kAll);
-      first.Apply(cb, Location("vkQueueSubmit"));
-      REQUIRE_FALSE(first.Finish());
-    }
+    w.state.command_buffers.End(cb);
+    REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {cb}).reported);
     if (sc.update) {
-      ResetCommandBufferLog(w.state, cb);
+      w.state.command_buffers.Reset(cb);
       const size_t count = builds.size();
       for (size_t i = 0; i < count; ++i) {
         builds.emplace_back(handles[i], std::vector<uint32_t>{4, 4}, kUpdatable, handles[i]);
       }
       for (size_t i = count; i < builds.size(); ++i) {
-        cmd.infos = &builds[i].info;
-        cmd.ranges = &builds[i].range_pointer;
-        RecordDeviceBuild(w.state, kAll, cmd);
+        RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &builds[i].info, &builds[i].range_pointer);
       }
+      w.state.command_buffers.End(cb);
     }
     const auto start = std::chrono::steady_clock::now();
     uint64_t ops = 0;
     for (uint32_t s = 0; s < sc.submissions; ++s) {
-      SubmitHistory submit(w.state, reporter, kAll);
-      submit.Apply(cb, Location("vkQueueSubmit"));
-      REQUIRE_FALSE(submit.Finish());
-      ops += submit.ops_applied();
+      const Submitted submitted = SubmitCommandBuffers(w, reporter, {cb});
+      REQUIRE_FALSE(submitted.reported);
+      ops += submitted.ops;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("%s: %u submissions, %llu operations, %.0f ns per submission, %.2f M operations/s\n", sc.name,

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "build_state_fixture.h"
-#include "history_record.h"
+#include "history_recorder.h"
 #include "host_mappings.h"
 
 namespace asval {
@@ -298,7 +298,8 @@ TEST_CASE("deferredOperation-03678: a deferred operation still running an earlie
   BuildCommand first = scene.Command();
   first.deferred_operation = operation;
   // The first build went down and was deferred.
-  FinishHostBuild(f.state, kCheckHistory, first, VK_OPERATION_DEFERRED_KHR);
+  FinishHostOps(f.state, HostBuildOps(first.info_count, first.infos, first.ranges), first.deferred_operation,
+                VK_OPERATION_DEFERRED_KHR);
   BuildCommand second = scene.Command();
   second.deferred_operation = operation;
   f.Validate(second);

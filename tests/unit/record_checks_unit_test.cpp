@@ -258,7 +258,7 @@ TEST_CASE("record checks: unknown state is skipped and counted, never guessed", 
   CHECK(skipped() > before);
 
   // A protected pool exists, but this command buffer was never seen allocated.
-  h.state().command_buffer_levels.any_protected_pool = true;
+  h.state().command_buffers.CreatePool(reinterpret_cast<VkCommandPool>(0x31), VK_COMMAND_POOL_CREATE_PROTECTED_BIT);
   before = skipped();
   CHECK(h.Run(kDirect, {info}, {ranges.data()}, kCheckFeatures).empty());
   CHECK(skipped() == before + 1);
@@ -273,15 +273,20 @@ TEST_CASE("record checks: a protected command buffer is found through its pool (
       InfoOf(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, &triangles, 1,
              h.AddStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR), kScratch);
   const Ranges ranges(1, VkAccelerationStructureBuildRangeInfoKHR{1, 0, 0, 0});
-  CommandBufferLevels& levels = h.state().command_buffer_levels;
-  levels.any_protected_pool = true;
-  CommandBufferInfo record;  // the harness records into command buffer 0x20
-  record.pool = reinterpret_cast<VkCommandPool>(0x30);
-  levels.buffers.insert_or_assign(reinterpret_cast<VkCommandBuffer>(0x20), record);
+  CommandBufferMap& map = h.state().command_buffers;
+  const auto plain = reinterpret_cast<VkCommandPool>(0x30), guarded = reinterpret_cast<VkCommandPool>(0x31);
+  map.CreatePool(plain, 0);
+  map.CreatePool(guarded, VK_COMMAND_POOL_CREATE_PROTECTED_BIT);
+  const auto cb = reinterpret_cast<VkCommandBuffer>(0x20);  // the harness records into command buffer 0x20
+  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, plain,
+                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1},
+               &cb);
   CHECK(h.Run(kDirect, {info}, {ranges.data()}).empty());
   CHECK(h.Run(kIndirect, {info}, {ranges.data()}).empty());
-  record.is_protected = true;
-  levels.buffers.insert_or_assign(reinterpret_cast<VkCommandBuffer>(0x20), record);
+  map.Free(1, &cb);
+  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, guarded,
+                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1},
+               &cb);
   CHECK(h.Run(kDirect, {info}, {ranges.data()}) ==
         std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-commandBuffer-09547"});
   CHECK(h.Run(kIndirect, {info}, {ranges.data()}) ==

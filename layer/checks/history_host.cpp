@@ -1,0 +1,46 @@
+#include "history_host.h"
+
+#include <fmt/format.h>
+
+#include <mutex>
+
+#include "history_findings.h"
+#include "history_recorder.h"
+#include "update_rules.h"
+
+namespace asval {
+
+bool ValidateHostOps(const CheckContext& ctx, const OpBatch& batch, const char* function) {
+  if (!ctx.state.history_tracked || batch.empty()) return false;
+  HistoryFindings findings;
+  {
+    std::unique_lock<std::mutex> lock = ctx.state.history.store.Lock();
+    const HistoryCheckSite site{Location(function), VK_NULL_HANDLE, false};
+    for (const AsOp& op : batch.ops()) {
+      CheckOpHistory(ctx.state, ctx.state.history.store, ctx.enabled_checks, batch, op, site, findings);
+    }
+  }
+  return findings.ReportAll(ctx.reporter);  // no lock held: the app's callback may call Vulkan
+}
+
+bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (!cmd.is_host() || !cmd.infos) return false;  // device builds: checked at submission
+  return ValidateHostOps(ctx, HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges), cmd.function);
+}
+
+void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const HistoryStore& store = state.history.store;
+  const uint64_t skipped = store.rules_skipped_unknown_history.load(std::memory_order_relaxed);
+  if (skipped == 0) return;
+  reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
+                  {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+                  fmt::format("{} history checks were skipped because the history they need was unknown "
+                              "({} structures got an unknown history: deserialized from bytes the layer could not "
+                              "verify, copied from such a structure, written by a command buffer the layer did not "
+                              "see recorded, or operations the layer could not record). "
+                              "{} operations were applied in execution order.",
+                              skipped, store.structures_made_unknown.load(std::memory_order_relaxed),
+                              store.ops_applied.load(std::memory_order_relaxed)));
+}
+
+}  // namespace asval

@@ -1,0 +1,33 @@
+#pragma once
+// The history rules at vkQueueSubmit (layer/checks: const, they only report). HistorySubmission
+// (layer/state/submission.h) applies each submitted operation to the histories and calls the check returned
+// by For() just before, so each operation is judged against what the operations before it left. Findings are
+// collected while the history lock is held and reported after it is released.
+#include <vulkan/vulkan.h>
+
+#include "check_context.h"
+#include "history_findings.h"
+#include "update_rules.h"
+
+namespace asval {
+
+class SubmitChecks {
+ public:
+  explicit SubmitChecks(const CheckContext& ctx) : ctx_(ctx) {}
+
+  // The check for the operations of one submitted command buffer; loc names it in the call's parameters.
+  auto For(VkCommandBuffer cb, const Location& loc) {
+    return [this, site = HistoryCheckSite{loc, cb, true}](const HistoryStore& store, const OpBatch& batch,
+                                                          const AsOp& op) {
+      CheckOpHistory(ctx_.state, store, ctx_.enabled_checks, batch, op, site, findings_);
+    };
+  }
+  // Reports every finding (call with no lock held). True when a callback asked to skip the submission.
+  bool ReportAll() const { return !findings_.empty() && findings_.ReportAll(ctx_.reporter); }
+
+ private:
+  const CheckContext& ctx_;
+  HistoryFindings findings_;
+};
+
+}  // namespace asval

@@ -1,0 +1,115 @@
+#pragma once
+// Per-command-buffer shadow state: one CommandBufferState per command buffer (its pool, level, protected-ness,
+// the acceleration-structure operations it records and the secondaries it executes) in one map, and the pools
+// that own them.
+//
+// Threads. A command buffer's recording (`recording`, `calls`, `secondaries`) is written only by the thread that
+// records it: the app must externally synchronize the command buffer (and its pool) while it begins, records,
+// ends, resets or frees it. Other threads read what a command buffer does when it is submitted or executed by a
+// primary, and neither vkQueueSubmit's nor vkCmdExecuteCommands' command buffers are externally synchronized:
+// another thread may be re-recording one at that moment (an app bug, but never a data race in the layer). So
+// readers never look at the recording: vkEndCommandBuffer publishes it as an immutable RecordedOps, and readers
+// take that snapshot under the command buffer's own small mutex (one lock per end, execute and submitted
+// command buffer; none per recorded command).
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "command_buffer_ops.h"
+#include "concurrent_map.h"
+
+namespace asval {
+
+// What one completed recording of a command buffer does to acceleration structures.
+struct RecordedOps {
+  OpBatch batch;
+  // Some operation could not be recorded (allocation failure, or a secondary the layer does not know was
+  // executed): what this command buffer does to structures is unknown.
+  bool lost = false;
+};
+
+class CommandBufferState {
+ public:
+  CommandBufferState(VkCommandPool owner, VkCommandBufferLevel buffer_level, bool in_protected_pool)
+      : pool(owner), level(buffer_level), is_protected(in_protected_pool) {}
+
+  // Fixed at allocation.
+  const VkCommandPool pool;
+  const VkCommandBufferLevel level;
+  const bool is_protected;  // allocated from a pool created with VK_COMMAND_POOL_CREATE_PROTECTED_BIT
+
+  // ---- the recording thread only ----
+  OpBatch recording;
+  bool recording_lost = false;
+  // Secondaries executed by vkCmdExecuteCommands, in order (the capture of execution-time data follows them).
+  std::vector<VkCommandBuffer> secondaries;
+  // 1-based ordinal of the next call of `command`, for messages ("the 3rd vkCmd...").
+  uint32_t NextOrdinal(OpCommand command) { return ++calls_[static_cast<std::size_t>(command)]; }
+  // vkBeginCommandBuffer, vkResetCommandBuffer, vkResetCommandPool: empty recording, nothing published.
+  void Reset();
+  // vkEndCommandBuffer: the recording becomes what submissions and primaries see.
+  void Publish();
+
+  // ---- any thread ----
+  // The operations of the last completed recording; null when it has none (or the command buffer is being
+  // recorded again).
+  std::shared_ptr<const RecordedOps> Executable() const {
+    std::lock_guard<std::mutex> lock(published_mutex_);
+    return published_;
+  }
+
+ private:
+  std::array<uint32_t, kOpCommandCount> calls_{};
+  mutable std::mutex published_mutex_;
+  std::shared_ptr<const RecordedOps> published_;
+  // A published snapshot nobody else holds any more, kept so that the next Publish reuses its storage: a
+  // command buffer re-recorded every frame allocates nothing in the steady state.
+  std::shared_ptr<RecordedOps> spare_;
+};
+
+class CommandBufferMap {
+ public:
+  void CreatePool(VkCommandPool pool, VkCommandPoolCreateFlags flags);
+  // Forgets the pool and its command buffers (before the driver frees them: afterwards their handles may be
+  // handed out again by another thread's allocation, whose records must not be erased here).
+  void DestroyPool(VkCommandPool pool);
+  void ResetPool(VkCommandPool pool);
+  void Allocate(const VkCommandBufferAllocateInfo& info, const VkCommandBuffer* buffers);
+  void Free(uint32_t count, const VkCommandBuffer* buffers);
+  // vkBeginCommandBuffer, vkResetCommandBuffer (after success): the recording starts empty.
+  void Reset(VkCommandBuffer cb) {
+    if (std::shared_ptr<CommandBufferState> state = Find(cb)) state->Reset();
+  }
+  // vkEndCommandBuffer (after success): the recording becomes what submissions and primaries see.
+  void End(VkCommandBuffer cb) {
+    if (std::shared_ptr<CommandBufferState> state = Find(cb)) state->Publish();
+  }
+
+  // The state of a command buffer, or null when the layer never saw it allocated.
+  std::shared_ptr<CommandBufferState> Find(VkCommandBuffer cb) const {
+    std::optional<std::shared_ptr<CommandBufferState>> found = buffers_.find(cb);
+    return found ? *found : nullptr;
+  }
+  // Set once the first protected pool is created. Until then no command buffer can be protected, so the build
+  // commands' commandBuffer-09547 is a single load and no map lookup: protected memory is rare.
+  bool AnyProtectedPool() const { return any_protected_pool_.load(std::memory_order_acquire); }
+  std::size_t size() const { return buffers_.size(); }
+
+ private:
+  struct PoolState {
+    VkCommandPoolCreateFlags flags = 0;
+    // Written only under the app's external synchronization of the pool.
+    std::vector<VkCommandBuffer> buffers;
+  };
+  std::shared_ptr<PoolState> PoolOf(VkCommandPool pool) const;
+
+  ConcurrentMap<VkCommandBuffer, std::shared_ptr<CommandBufferState>, 6> buffers_;
+  ConcurrentMap<VkCommandPool, std::shared_ptr<PoolState>> pools_;
+  std::atomic<bool> any_protected_pool_{false};
+};
+
+}  // namespace asval

@@ -1,0 +1,309 @@
+#include "history_recorder.h"
+
+#include <cstring>
+#include <new>
+
+#include "history_apply.h"
+
+namespace asval {
+
+namespace {
+
+// The command buffer being recorded, or null when history is off or the command buffer unknown (then the
+// submission makes every structure's history unknown: see submission.h).
+std::shared_ptr<CommandBufferState> Recording(DeviceState& state, VkCommandBuffer cb) {
+  if (!state.history_tracked) return nullptr;
+  return state.command_buffers.Find(cb);
+}
+
+// Runs an append; an allocation failure leaves the recording marked lost rather than silently incomplete.
+template <typename F>
+void Guarded(CommandBufferState& cb, F&& append) {
+  try {
+    append();
+  } catch (const std::bad_alloc&) {
+    cb.recording_lost = true;
+  }
+}
+
+OpOrigin DeviceOrigin(CommandBufferState& state, OpCommand command, VkCommandBuffer cb) {
+  OpOrigin origin;
+  origin.command = command;
+  origin.ordinal = state.NextOrdinal(command);
+  origin.command_buffer = cb;
+  return origin;
+}
+
+OpOrigin HostOrigin(OpCommand command) {
+  OpOrigin origin;
+  origin.command = command;
+  return origin;
+}
+
+// The memory behind a device address that serialized data is written to or read from.
+SerializedLocation ResolveDeviceLocation(const DeviceState& state, VkDeviceAddress address) {
+  SerializedLocation where;
+  where.device_address = address;
+  AddressHits hits;
+  state.buffer_addresses.FindContaining(address, hits);
+  for (const AddressHit& hit : hits) {
+    const VkDeviceSize remaining = hit.base + hit.size - address;
+    if (remaining <= where.capacity) continue;
+    std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(hit.buffer);
+    if (!buffer || !*buffer || !(*buffer)->bound || (*buffer)->memory == VK_NULL_HANDLE) continue;
+    const MemoryBinding binding{(*buffer)->memory, (*buffer)->memory_offset, true};
+    std::optional<MemorySpan> span = ResolveMemorySpan(binding, address - hit.base, remaining);
+    if (!span) continue;
+    where.span = *span;
+    where.capacity = remaining;
+  }
+  return where;
+}
+
+AsOp CopyOp(const VkCopyAccelerationStructureInfoKHR& info) {
+  AsOp op;
+  op.kind = OpKind::kCopy;
+  op.src = info.src;
+  op.dst = info.dst;
+  op.copy_mode = info.mode;
+  return op;
+}
+
+AsOp SerializeOp(const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
+  AsOp op;
+  op.kind = OpKind::kSerialize;
+  op.src = info.src;
+  op.copy_mode = info.mode;
+  return op;
+}
+
+AsOp DeserializeOp(const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
+  AsOp op;
+  op.kind = OpKind::kDeserialize;
+  op.dst = info.dst;
+  op.copy_mode = info.mode;
+  return op;
+}
+
+void ApplyNow(DeviceState& state, const OpBatch& batch) {
+  std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  for (const AsOp& op : batch.ops()) ApplyOp(state, state.history.store, batch, op, nullptr);
+}
+
+}  // namespace
+
+// ---- device commands -----------------------------------------------------------------------------------------
+
+void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
+                    const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording || !infos) return;
+  const OpOrigin origin = DeviceOrigin(*recording, command, cb);
+  Guarded(*recording, [&] { recording->recording.AppendBuilds(origin, info_count, infos, ranges); });
+}
+
+void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording) return;
+  AsOp op = CopyOp(info);
+  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopy, cb);
+  Guarded(*recording, [&] { recording->recording.Append(op); });
+}
+
+void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
+                           const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording) return;
+  AsOp op = SerializeOp(info);
+  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyToMemory, cb);
+  op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);
+  Guarded(*recording, [&] { recording->recording.Append(op); });
+}
+
+void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
+                           const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording) return;
+  AsOp op = DeserializeOp(info);
+  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyMemoryTo, cb);
+  op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);
+  Guarded(*recording, [&] { recording->recording.Append(op); });
+}
+
+void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
+                              const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
+                              uint32_t first_query) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording || !structures) return;
+  const OpOrigin origin = DeviceOrigin(*recording, OpCommand::kCmdWriteProperties, cb);
+  Guarded(*recording, [&] {
+    for (uint32_t i = 0; i < count; ++i) {
+      AsOp op;
+      op.kind = OpKind::kWriteProperties;
+      op.origin = origin;
+      op.origin.element = i;
+      op.dst = structures[i];
+      op.query_type = type;
+      op.query_pool = pool;
+      op.query = first_query + i;
+      recording->recording.Append(op);
+    }
+  });
+}
+
+void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
+                           const VkCommandBuffer* secondaries) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, primary);
+  if (!recording || !secondaries) return;
+  for (uint32_t i = 0; i < count; ++i) {
+    Guarded(*recording, [&] { recording->secondaries.push_back(secondaries[i]); });
+    const std::shared_ptr<CommandBufferState> secondary = state.command_buffers.Find(secondaries[i]);
+    if (!secondary) {
+      recording->recording_lost = true;
+      continue;
+    }
+    // The secondary's last completed recording: another thread may be re-recording it right now.
+    const std::shared_ptr<const RecordedOps> ops = secondary->Executable();
+    if (!ops) continue;
+    if (ops->lost) recording->recording_lost = true;
+    Guarded(*recording, [&] { recording->recording.AppendExecuted(ops->batch, primary); });
+  }
+}
+
+// ---- host commands -------------------------------------------------------------------------------------------
+
+OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+  OpBatch batch;
+  if (infos) batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges);
+  return batch;
+}
+
+OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info) {
+  OpBatch batch;
+  AsOp op = CopyOp(info);
+  op.origin = HostOrigin(OpCommand::kHostCopy);
+  batch.Append(op);
+  return batch;
+}
+
+OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
+  OpBatch batch;
+  AsOp op = SerializeOp(info);
+  op.origin = HostOrigin(OpCommand::kHostCopyToMemory);
+  op.memory.host_address = info.dst.hostAddress;
+  batch.Append(op);
+  return batch;
+}
+
+OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
+  OpBatch batch;
+  AsOp op = DeserializeOp(info);
+  op.origin = HostOrigin(OpCommand::kHostCopyMemoryTo);
+  op.memory.host_address = info.src.hostAddress;
+  batch.Append(op);
+  return batch;
+}
+
+OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR* structures, VkQueryType type) {
+  OpBatch batch;
+  for (uint32_t i = 0; structures && i < count; ++i) {
+    AsOp op;
+    op.kind = OpKind::kWriteProperties;
+    op.origin = HostOrigin(OpCommand::kHostWriteProperties);
+    op.origin.element = i;
+    op.dst = structures[i];
+    op.query_type = type;
+    batch.Append(op);
+  }
+  return batch;
+}
+
+void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result) {
+  if (!state.history_tracked || batch.empty()) return;
+  if (result == VK_SUCCESS || result == VK_OPERATION_NOT_DEFERRED_KHR) {
+    ApplyNow(state, batch);
+  } else if (result == VK_OPERATION_DEFERRED_KHR && deferred) {
+    auto pending = std::make_unique<DeferredHostOps>();
+    pending->batch = std::move(batch);
+    std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
+    auto [it, inserted] = state.history.deferred.try_emplace(deferred, std::move(pending));
+    if (!inserted) it->second->batch.AppendExecuted(pending->batch, VK_NULL_HANDLE);
+  }
+  // Any other result: the command failed and changed nothing the layer can rely on.
+}
+
+void RecordHostSerializationSizes(DeviceState& state, uint32_t count, const VkAccelerationStructureKHR* structures,
+                                  const void* data, size_t stride) {
+  if (!state.history_tracked || !structures || !data) return;
+  HistoryStore& store = state.history.store;
+  std::unique_lock<std::mutex> lock = store.Lock();
+  for (uint32_t i = 0; i < count; ++i) {
+    uint64_t size = 0;
+    std::memcpy(&size, static_cast<const unsigned char*>(data) + i * stride, sizeof(size));
+    if (const AsHistory* h = store.Find(structures[i])) {
+      RecordSerializationSize(store, structures[i], h->generation, size);
+    }
+  }
+}
+
+// ---- deferred operations -------------------------------------------------------------------------------------
+
+void CompleteDeferredOps(DeviceState& state, VkDeferredOperationKHR deferred, VkResult result) {
+  std::unique_ptr<DeferredHostOps> pending;
+  {
+    std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
+    auto it = state.history.deferred.find(deferred);
+    if (it == state.history.deferred.end()) return;
+    pending = std::move(it->second);
+    state.history.deferred.erase(it);
+  }
+  if (result == VK_SUCCESS) ApplyNow(state, pending->batch);
+}
+
+bool HasDeferredOps(const DeviceState& state, VkDeferredOperationKHR deferred) {
+  std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
+  return state.history.deferred.count(deferred) != 0;
+}
+
+// ---- query results -------------------------------------------------------------------------------------------
+
+void RecordQueryResults(DeviceState& state, VkQueryPool pool, uint32_t first_query, uint32_t query_count,
+                        size_t data_size, const void* data, VkDeviceSize stride, VkQueryResultFlags flags,
+                        VkResult result) {
+  if (!state.history_tracked || !data || (result != VK_SUCCESS && result != VK_NOT_READY)) return;
+  // Only serialization sizes interest the layer: other pools (timestamps, occlusion) cost one map lookup.
+  const std::optional<QueryPoolState> pool_state = state.history.query_pools.find(pool);
+  if (!pool_state || pool_state->type != VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) return;
+  HistoryStore& store = state.history.store;
+  std::unique_lock<std::mutex> lock = store.Lock();
+  const bool wide = (flags & VK_QUERY_RESULT_64_BIT) != 0;
+  const size_t value_size = wide ? 8 : 4;
+  const bool availability = (flags & VK_QUERY_RESULT_WITH_AVAILABILITY_BIT) != 0;
+  for (uint32_t i = 0; i < query_count; ++i) {
+    const QuerySlot* slot = store.FindSlot(pool, first_query + i);
+    if (!slot || slot->type != VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) continue;
+    const size_t offset = static_cast<size_t>(stride) * i;
+    if (offset + value_size * (availability ? 2 : 1) > data_size) break;
+    const auto* bytes = static_cast<const unsigned char*>(data) + offset;
+    uint64_t value = 0, available = result == VK_SUCCESS ? 1 : 0;
+    if (wide) {
+      std::memcpy(&value, bytes, 8);
+      if (availability) std::memcpy(&available, bytes + 8, 8);
+    } else {
+      uint32_t v32 = 0, a32 = 0;
+      std::memcpy(&v32, bytes, 4);
+      value = v32;
+      if (availability) {
+        std::memcpy(&a32, bytes + 4, 4);
+        available = a32;
+      }
+    }
+    // VK_QUERY_RESULT_PARTIAL_BIT values of unavailable queries are not final.
+    if (!available) continue;
+    RecordSerializationSize(store, slot->as, slot->generation, value);
+  }
+}
+
+}  // namespace asval

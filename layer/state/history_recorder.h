@@ -1,0 +1,56 @@
+#pragma once
+// Recording side of the build history (the writes; the rules are in layer/checks/update_rules.h):
+//   device commands: append operations to the command buffer's recording (applied at submission: submission.h);
+//   host commands:   applied when they complete (at once, or when the deferred operation is seen to complete);
+//   query results:   serialization sizes read back, attached to the structures' current contents.
+// Every function does nothing when DeviceState::history_tracked is false.
+#include <vulkan/vulkan.h>
+
+#include "device_state.h"
+
+namespace asval {
+
+// ---- device commands (after the downcall) ----
+// ranges: null for indirect builds (the counts are on the device).
+void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
+                    const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info);
+void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
+                           const VkCopyAccelerationStructureToMemoryInfoKHR& info);
+void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
+                           const VkCopyMemoryToAccelerationStructureInfoKHR& info);
+void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
+                              const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
+                              uint32_t first_query);
+// vkCmdExecuteCommands: the secondaries' completed recordings join the primary's, in order.
+void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
+                           const VkCommandBuffer* secondaries);
+
+// ---- host commands: their operations (pure: built before the checks run) ----
+OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info);
+OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info);
+OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info);
+OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR* structures, VkQueryType type);
+
+// After a host command's downcall: applies its operations when it completed successfully, keeps them for the
+// deferred operation when it was deferred, drops them when it failed.
+void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result);
+// Serialization sizes a successful vkWriteAccelerationStructuresPropertiesKHR wrote to pData.
+void RecordHostSerializationSizes(DeviceState& state, uint32_t count, const VkAccelerationStructureKHR* structures,
+                                  const void* data, size_t stride);
+
+// ---- deferred operations ----
+// A deferred operation completed (result: its own result). Applies its operations on success.
+void CompleteDeferredOps(DeviceState& state, VkDeferredOperationKHR deferred, VkResult result);
+bool HasDeferredOps(const DeviceState& state, VkDeferredOperationKHR deferred);
+
+// ---- query results ----
+// vkGetQueryPoolResults returned: serialization sizes of structures whose property write was submitted.
+void RecordQueryResults(DeviceState& state, VkQueryPool pool, uint32_t first_query, uint32_t query_count,
+                        size_t data_size, const void* data, VkDeviceSize stride, VkQueryResultFlags flags,
+                        VkResult result);
+
+}  // namespace asval

@@ -1,0 +1,51 @@
+#pragma once
+// Where an acceleration structure's bytes live: its record and the record of the buffer it was created on. The
+// one resolver of structure -> buffer -> memory: every rule family and the history use it.
+//
+// A structure holds its buffer's identity (BufferState::id), not only the handle: after vkDestroyBuffer the
+// handle value may be handed to a new buffer, which must never be taken for the structure's.
+#include <vulkan/vulkan.h>
+
+#include <memory>
+#include <optional>
+
+#include "device_state.h"
+#include "memory_range.h"
+
+namespace asval {
+
+struct StructureMemory {
+  std::shared_ptr<const AccelerationStructureState> structure;
+  std::shared_ptr<const BufferState> buffer;
+
+  bool bound() const { return buffer && buffer->bound && buffer->memory != VK_NULL_HANDLE; }
+  // First byte of the structure in its VkDeviceMemory (only when bound()).
+  VkDeviceSize memory_offset() const { return buffer->memory_offset + structure->offset; }
+  // The VkDeviceMemory bytes the structure occupies; nullopt when not bound (or the arithmetic overflows).
+  std::optional<MemorySpan> Span() const {
+    if (!bound()) return std::nullopt;
+    return ResolveMemorySpan(MemoryBinding{buffer->memory, buffer->memory_offset, true}, structure->offset,
+                             structure->size);
+  }
+};
+
+// The live buffer a structure was created on; null when it is unknown or was destroyed (even if another buffer
+// now has its handle value).
+inline std::shared_ptr<const BufferState> BufferOfStructure(const DeviceState& state,
+                                                            const AccelerationStructureState& structure) {
+  std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(structure.buffer);
+  if (!buffer || !*buffer || (*buffer)->id != structure.buffer_id) return nullptr;
+  return std::move(*buffer);
+}
+
+// nullopt when the structure or its buffer is not known to the layer.
+inline std::optional<StructureMemory> MemoryOfStructure(const DeviceState& state, VkAccelerationStructureKHR handle) {
+  if (handle == VK_NULL_HANDLE) return std::nullopt;
+  std::optional<std::shared_ptr<const AccelerationStructureState>> structure = state.acceleration_structures.find(handle);
+  if (!structure || !*structure) return std::nullopt;
+  std::shared_ptr<const BufferState> buffer = BufferOfStructure(state, **structure);
+  if (!buffer) return std::nullopt;
+  return StructureMemory{std::move(*structure), std::move(buffer)};
+}
+
+}  // namespace asval

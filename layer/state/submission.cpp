@@ -1,0 +1,24 @@
+#include "submission.h"
+
+namespace asval {
+
+bool HistorySubmission::Lookup(VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) const {
+  const std::shared_ptr<CommandBufferState> record = state_.command_buffers.Find(cb);
+  if (!record) return true;  // never seen allocated: unknown
+  *ops = record->Executable();
+  return *ops != nullptr;
+}
+
+void HistorySubmission::Begin() {
+  if (!order_lock_.owns_lock()) order_lock_ = std::unique_lock<std::recursive_mutex>(state_.history.submission_order);
+  if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
+}
+
+void HistorySubmission::Undo() {
+  if (txn_.empty()) return;
+  if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
+  state_.history.store.Undo(txn_);
+  store_lock_.unlock();
+}
+
+}  // namespace asval

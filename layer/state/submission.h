@@ -1,0 +1,77 @@
+#pragma once
+// One queue submission's effect on the build history, applied speculatively and committed or rolled back:
+//
+//   HistorySubmission submission(state);
+//   for each submitted command buffer: submission.Apply(cb, check);  // check(store, batch, op) runs before
+//                                                                    // each op is applied (const: layer/checks)
+//   submission.EndApply();                 // the store's lock is released: findings may now be reported
+//   if (skip) { submission.Undo(); ... }   // a callback asked to skip the call
+//   result = downcall; if (result != VK_SUCCESS) submission.Undo();
+//
+// From the first command buffer with operations until the object is destroyed (after the downcall), the
+// device's submission_order lock is held: a submission on another queue waits, so it is never checked against
+// changes that are then undone. Submissions are rare next to recorded commands, and one order gives every
+// submission a single total order, which is the order the layer assumes the device executes them in (host
+// submission order; see docs/history.md).
+#include <vulkan/vulkan.h>
+
+#include <mutex>
+
+#include "device_state.h"
+#include "history_apply.h"
+
+namespace asval {
+
+class HistorySubmission {
+ public:
+  explicit HistorySubmission(DeviceState& state) : state_(state) {}
+  HistorySubmission(const HistorySubmission&) = delete;
+  HistorySubmission& operator=(const HistorySubmission&) = delete;
+  ~HistorySubmission() {
+    if (store_lock_.owns_lock()) store_lock_.unlock();
+  }
+
+  // Applies the operations of one submitted command buffer, in recording order, calling
+  // check(const HistoryStore&, const OpBatch&, const AsOp&) before each.
+  template <typename Check>
+  void Apply(VkCommandBuffer cb, Check&& check) {
+    if (!state_.history_tracked) return;
+    std::shared_ptr<const RecordedOps> ops;
+    if (!Lookup(cb, &ops)) return;  // most submitted command buffers build nothing: no lock
+    Begin();
+    if (!ops || ops->lost) {
+      // A command buffer the layer never saw allocated, or whose operations it could not record.
+      ApplyUnknownCommandBuffer(state_, state_.history.store, &txn_);
+      return;
+    }
+    const OpBatch& batch = ops->batch;
+    txn_.ReserveMore(batch.ops().size() * 2);  // one entry per written structure, and some clobbers
+    for (const AsOp& op : batch.ops()) {
+      check(static_cast<const HistoryStore&>(state_.history.store), batch, op);
+      ApplyOp(state_, state_.history.store, batch, op, &txn_);
+      ++ops_applied_;
+    }
+  }
+  // Releases the store's lock (the order lock stays held until destruction).
+  void EndApply() {
+    if (store_lock_.owns_lock()) store_lock_.unlock();
+  }
+  // The submission did not happen (skipped, or rejected by the driver): its changes are undone.
+  void Undo();
+
+  uint64_t ops_applied() const { return ops_applied_; }
+
+ private:
+  // False when the command buffer does nothing to structures; *ops null when what it does is unknown.
+  bool Lookup(VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) const;
+  void Begin();
+
+  DeviceState& state_;
+  // Declared before store_lock_: released after it.
+  std::unique_lock<std::recursive_mutex> order_lock_;
+  std::unique_lock<std::mutex> store_lock_;
+  Transaction txn_;
+  uint64_t ops_applied_ = 0;
+};
+
+}  // namespace asval
