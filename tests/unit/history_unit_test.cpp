@@ -19,6 +19,7 @@
 #include "submit_checks.h"
 #include "layer_settings.h"
 #include "state_tracker.h"
+#include "structure_memory.h"
 #include "update_rules.h"
 #include "vk_dispatch_table.h"
 
@@ -359,6 +360,50 @@ Submitted SubmitCommandBuffers(World& w, Reporter& reporter, std::initializer_li
   if (driver_result != VK_SUCCESS) submission.Undo();
   out.ops = submission.ops_applied();
   return out;
+}
+
+TEST_CASE("history unit: a structure does not resolve through a new buffer that reuses its buffer's handle",
+          "[history]") {
+  World w;
+  REQUIRE(MemoryOfStructure(w.state, w.a));
+  REQUIRE(AccelerationStructureSpan(w.state, w.a));
+  // The app destroys a's buffer (a is now unusable) and a new buffer gets the same handle value, bound to
+  // other memory.
+  RecordDestroyBuffer(w.state, Fake<VkBuffer>(2));
+  const VkDeviceMemory other = Fake<VkDeviceMemory>(9);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, nullptr, 1 << 20, 0};
+  RecordAllocateMemory(w.state, alloc, other);
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = 1 << 16;
+  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  RecordCreateBuffer(w.state, info, Fake<VkBuffer>(2));
+  RecordBindBufferMemory(w.state, w.dispatch, Fake<VkDevice>(1), Fake<VkBuffer>(2), other, 0);
+  CHECK_FALSE(MemoryOfStructure(w.state, w.a));
+  CHECK_FALSE(AccelerationStructureSpan(w.state, w.a));
+  CHECK(MemoryOfStructure(w.state, w.b));  // its neighbour is untouched
+}
+
+TEST_CASE("history unit: vkFreeMemory drops the address ranges, spans and serialized bytes in that memory",
+          "[history]") {
+  World w;
+  const Build build(w.a, {1}, kUpdatable);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&build})).empty());
+  const VkBufferDeviceAddressInfo info_2{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, Fake<VkBuffer>(2)};
+  const VkDeviceAddress base = FakeBufferAddress(VK_NULL_HANDLE, &info_2);
+  AddressHits hits;
+  w.state.buffer_addresses.FindContaining(base + 16, hits);
+  REQUIRE(hits.size() == 1);
+  {
+    auto lock = w.state.history.store.Lock();
+    REQUIRE(w.state.history.store.Get(w.a).span.memory == kMemory);
+  }
+  RecordFreeMemory(w.state, kMemory);
+  AddressHits after;
+  w.state.buffer_addresses.FindContaining(base + 16, after);
+  CHECK(after.size() == 0);  // a later buffer at these addresses must be the only one found
+  CHECK_FALSE(MemoryOfStructure(w.state, w.a)->bound());
+  auto lock = w.state.history.store.Lock();
+  CHECK(w.state.history.store.Get(w.a).span.memory == VK_NULL_HANDLE);
 }
 
 TEST_CASE("history unit: a submission on another queue waits for a rejected one, and is checked without it",
