@@ -14,6 +14,7 @@
 #include "copies.h"
 #include "history_apply.h"
 #include "history_host.h"
+#include "history_test_builds.h"
 #include "history_recorder.h"
 #include "submission.h"
 #include "submit_checks.h"
@@ -25,6 +26,8 @@
 
 namespace asval {
 namespace {
+
+using test::Build;
 
 template <typename H>
 H Fake(uintptr_t v) {
@@ -75,35 +78,14 @@ struct World {
   }
 };
 
-// One triangle geometry per count.
-struct Build {
-  std::vector<VkAccelerationStructureGeometryKHR> geometries;
-  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges;
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = nullptr;
-
-  Build(VkAccelerationStructureKHR dst, std::vector<uint32_t> counts, VkBuildAccelerationStructureFlagsKHR flags,
-        VkAccelerationStructureKHR update_src = VK_NULL_HANDLE) {
-    for (uint32_t count : counts) {
-      VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-      g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-      g.geometry.triangles.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
-      g.geometry.triangles.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-      g.geometry.triangles.maxVertex = 8;
-      geometries.push_back(g);
-      ranges.push_back(VkAccelerationStructureBuildRangeInfoKHR{count, 0, 0, 0});
-    }
-    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    info.flags = flags;
-    info.mode =
-        update_src ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    info.srcAccelerationStructure = update_src;
-    info.dstAccelerationStructure = dst;
-    info.geometryCount = static_cast<uint32_t>(geometries.size());
-    info.pGeometries = geometries.data();
-    range_pointer = ranges.data();
-  }
-};
+// Allocates `count` primary command buffers of a new pool through the state's own entry points.
+void AllocateCommandBuffers(DeviceState& state, VkCommandPool pool, uint32_t count, const VkCommandBuffer* cbs) {
+  state.command_buffers.CreatePool(pool, 0);
+  state.command_buffers.Allocate(
+      VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
+                                  VK_COMMAND_BUFFER_LEVEL_PRIMARY, count},
+      cbs);
+}
 
 constexpr VkBuildAccelerationStructureFlagsKHR kUpdatable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
 
@@ -414,10 +396,7 @@ TEST_CASE("history unit: a submission on another queue waits for a rejected one,
   const VkCommandPool pool = Fake<VkCommandPool>(3);
   const VkCommandBuffer rebuild = Fake<VkCommandBuffer>(100), update = Fake<VkCommandBuffer>(101);
   const VkCommandBuffer both[] = {rebuild, update};
-  map.CreatePool(pool, 0);
-  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
-                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
-               both);
+  AllocateCommandBuffers(w.state, pool, 2, both);
   // Executed: a with one geometry. Queue 1 rebuilds it with two, and the driver rejects that submission;
   // queue 2, meanwhile, updates it with one geometry: valid, because the rebuild never happened.
   const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), update_one(w.a, {1}, kUpdatable, w.a);
@@ -524,10 +503,7 @@ TEST_CASE("history unit: command-buffer states follow allocation, secondaries, r
   CommandBufferMap& map = w.state.command_buffers;
   const VkCommandPool pool = Fake<VkCommandPool>(3);
   const VkCommandBuffer cbs[] = {Fake<VkCommandBuffer>(100), Fake<VkCommandBuffer>(101)};
-  map.CreatePool(pool, 0);
-  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
-                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
-               cbs);
+  AllocateCommandBuffers(w.state, pool, 2, cbs);
   const Build build(w.a, {1}, kUpdatable);
   map.Reset(cbs[1]);  // the secondary
   RecordCmdBuild(w.state, cbs[1], OpCommand::kCmdBuild, 1, &build.info, &build.range_pointer);
@@ -563,11 +539,8 @@ TEST_CASE("history unit: a primary takes a secondary's last completed recording,
   CommandBufferMap& map = w.state.command_buffers;
   const VkCommandPool pool = Fake<VkCommandPool>(3);
   const VkCommandBuffer primary = Fake<VkCommandBuffer>(100), secondary = Fake<VkCommandBuffer>(101);
-  map.CreatePool(pool, 0);
   const VkCommandBuffer both[] = {primary, secondary};
-  map.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool,
-                                           VK_COMMAND_BUFFER_LEVEL_PRIMARY, 2},
-               both);
+  AllocateCommandBuffers(w.state, pool, 2, both);
   const Build of_a(w.a, {1}, kUpdatable), of_b(w.b, {1}, kUpdatable);
   map.Reset(secondary);
   RecordCmdBuild(w.state, secondary, OpCommand::kCmdBuild, 1, &of_a.info, &of_a.range_pointer);
@@ -683,10 +656,7 @@ TEST_CASE("history bench: operations applied per second at submission", "[.histo
     Reporter reporter(ReportSettings{});
     const VkCommandPool pool = Fake<VkCommandPool>(3);
     const VkCommandBuffer cb = Fake<VkCommandBuffer>(100);
-    w.state.command_buffers.CreatePool(pool, 0);
-    w.state.command_buffers.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-                                                                 nullptr, pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1},
-                                     &cb);
+    AllocateCommandBuffers(w.state, pool, 1, &cb);
     w.state.command_buffers.Reset(cb);
     std::vector<Build> builds;
     builds.reserve(sc.structures * 2);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "history_recorder.h"
+#include "history_test_builds.h"
 #include "layer_data.h"
 #include "state_tracker.h"
 #include "vk_intercepts.h"
@@ -50,32 +51,11 @@ H Fake(uintptr_t v) {
   return reinterpret_cast<H>(v);
 }
 
-// One triangle geometry per count.
-struct Build {
-  std::vector<VkAccelerationStructureGeometryKHR> geometries;
-  std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges;
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = nullptr;
-  Build(VkAccelerationStructureKHR dst, uint32_t geometry_count, bool update) {
-    for (uint32_t j = 0; j < geometry_count; ++j) {
-      VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-      g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-      g.geometry.triangles.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
-      g.geometry.triangles.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-      g.geometry.triangles.maxVertex = 2;
-      geometries.push_back(g);
-      ranges.push_back(VkAccelerationStructureBuildRangeInfoKHR{1, 0, 0, 0});
-    }
-    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
-    info.mode = update ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    info.srcAccelerationStructure = update ? dst : VK_NULL_HANDLE;
-    info.dstAccelerationStructure = dst;
-    info.geometryCount = geometry_count;
-    info.pGeometries = geometries.data();
-    range_pointer = ranges.data();
-  }
-};
+// `geometries` one-triangle geometries; an update of dst by itself when `update`.
+test::Build TriangleBuild(VkAccelerationStructureKHR dst, uint32_t geometries, bool update) {
+  return test::Build(dst, std::vector<uint32_t>(geometries, 1), VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR,
+                     update ? dst : VK_NULL_HANDLE);
+}
 
 // A device registered with the layer whose next element is the fake driver above; history family only.
 class FakeDevice {
@@ -132,7 +112,7 @@ class FakeDevice {
   static VkAccelerationStructureKHR structure() { return Fake<VkAccelerationStructureKHR>(10); }
 
   // Records `build` into command buffer i through the hooks.
-  void Record(int i, const Build& build) {
+  void Record(int i, const test::Build& build) {
     const VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     REQUIRE(hooks::BeginCommandBuffer(cb(i), &begin) == VK_SUCCESS);
     hooks::CmdBuildAccelerationStructuresKHR(cb(i), 1, &build.info, &build.range_pointer);
@@ -161,16 +141,16 @@ class FakeDevice {
 TEST_CASE("submit hook: a submission the driver rejects leaves the history as if it had never been made",
           "[history][hook]") {
   FakeDevice d;
-  d.Record(0, Build(FakeDevice::structure(), 1, false));
+  d.Record(0, TriangleBuild(FakeDevice::structure(), 1, false));
   REQUIRE(d.Submit(0) == VK_SUCCESS);
-  d.Record(1, Build(FakeDevice::structure(), 2, false));
+  d.Record(1, TriangleBuild(FakeDevice::structure(), 2, false));
   g_driver.result = VK_ERROR_DEVICE_LOST;
   CHECK(d.Submit(1) == VK_ERROR_DEVICE_LOST);
   CHECK(g_driver.submits == 2);
   CHECK(d.GeometriesOfLastBuild() == 1);
   // An update that repeats the build that did execute is valid.
   g_driver.result = VK_SUCCESS;
-  d.Record(1, Build(FakeDevice::structure(), 1, true));
+  d.Record(1, TriangleBuild(FakeDevice::structure(), 1, true));
   CHECK(d.Submit(1) == VK_SUCCESS);
   CHECK(d.collected.vuids.empty());
   CHECK(g_driver.submits == 3);
@@ -179,10 +159,11 @@ TEST_CASE("submit hook: a submission the driver rejects leaves the history as if
 TEST_CASE("submit hook: a submission the app's callback skips never reaches the driver and changes nothing",
           "[history][hook]") {
   FakeDevice d;
-  d.Record(0, Build(FakeDevice::structure(), 1, false));
+  d.Record(0, TriangleBuild(FakeDevice::structure(), 1, false));
   REQUIRE(d.Submit(0) == VK_SUCCESS);
   // A rebuild with two geometries, then an update with one: the update contradicts the rebuild before it.
-  const Build rebuild(FakeDevice::structure(), 2, false), update(FakeDevice::structure(), 1, true);
+  const test::Build rebuild = TriangleBuild(FakeDevice::structure(), 2, false);
+  const test::Build update = TriangleBuild(FakeDevice::structure(), 1, true);
   const VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   REQUIRE(hooks::BeginCommandBuffer(FakeDevice::cb(1), &begin) == VK_SUCCESS);
   hooks::CmdBuildAccelerationStructuresKHR(FakeDevice::cb(1), 1, &rebuild.info, &rebuild.range_pointer);
