@@ -6,6 +6,12 @@ the enabled_checks setting in scripts/settings.json), its status and the tests t
 script checks the registry against the VUIDs of the specification chapter (scripts/vuids_newer.json), the
 families, and the test sources, then writes the coverage table. --verify (run by CTest) exits non-zero
 when the registry is inconsistent or docs/coverage.md is stale.
+
+A checked VUID names its firing test first. That test's expectations (Expect..., CHECK, REQUIRE) must name
+the VUID, in full or by its suffix (pInfos-03710), in the test body or through what the body uses from its
+own file: a constant (kVuid), a table (Rules()), a local set from one, or a helper's own expectations. This
+is read from the source text, not compiled: a test that names the VUID only in a comment, or only in a
+statement that expects nothing, does not count.
 """
 import argparse
 import json
@@ -53,27 +59,221 @@ def test_sources():
     return texts
 
 
-def test_case_names(sources):
-    """Names of every TEST_CASE, with adjacent string literals joined as the compiler joins them."""
-    names = {}
+def blank(text, strings=False):
+    """The text with every comment blanked, and with strings also the contents of string and character
+    literals (same length, newlines kept): a VUID in a comment never counts, and the shape of the code
+    (brackets, declarations) is read where no literal can fool it."""
+    out, i, n = list(text), 0, len(text)
+    while i < n:
+        c = text[i]
+        if c in "\"'":
+            start = i + 1
+            i += 1
+            while i < n and text[i] != c:
+                i += 2 if text[i] == "\\" else 1
+            if strings:
+                out[start:i] = " " * (i - start)
+            i += 1
+        elif text.startswith("//", i):
+            end = text.find("\n", i)
+            end = n if end < 0 else end
+            out[i:end] = " " * (end - i)
+            i = end
+        elif text.startswith("/*", i):
+            end = text.find("*/", i + 2)
+            end = n if end < 0 else end + 2
+            out[i:end] = [ch if ch == "\n" else " " for ch in text[i:end]]
+            i = end
+        else:
+            i += 1
+    return "".join(out)
+
+
+def matching(shape, open_pos):
+    """Index just past the bracket that closes the one at open_pos, in text whose literals are blanked."""
+    pairs = {"{": "}", "(": ")", "[": "]"}
+    stack = []
+    for i in range(open_pos, len(shape)):
+        c = shape[i]
+        if c in pairs:
+            stack.append(pairs[c])
+        elif c in ")}]":
+            if not stack or stack.pop() != c:
+                return None
+            if not stack:
+                return i + 1
+    return None
+
+
+class TestCase:
+    """One TEST_CASE: the file it sits in, as code (comments blanked) and as shape (literals blanked too),
+    and where its body is in them."""
+
+    def __init__(self, path, code, shape, body_start, body_end):
+        self.path, self.code, self.shape = path, code, shape
+        self.body_start, self.body_end = body_start, body_end
+
+    @property
+    def body(self):
+        return self.code[self.body_start:self.body_end]
+
+
+def test_cases(sources):
+    """Every TEST_CASE by name (adjacent string literals joined as the compiler joins them)."""
+    cases = {}
     literal = re.compile(r'\s*"((?:[^"\\]|\\.)*)"')
     for path, text in sources.items():
-        for start in re.finditer(r"TEST_CASE\(", text):
+        code, shape = blank(text), blank(text, strings=True)
+        for start in re.finditer(r"\bTEST_CASE\(", shape):
             pos, name = start.end(), ""
             while True:
-                match = literal.match(text, pos)
+                match = literal.match(code, pos)
                 if not match:
                     break
                 name += match.group(1)
                 pos = match.end()
-            if name:
-                names[name] = path
-    return names
+            if not name:
+                continue
+            close = matching(shape, start.end() - 1)
+            brace = shape.find("{", close) if close else -1
+            end = matching(shape, brace) if brace >= 0 else None
+            cases[name] = TestCase(path, code, shape, brace, end or brace)
+    return cases
+
+
+def test_case_names(sources):
+    return {name: case.path for name, case in test_cases(sources).items()}
+
+
+IDENTIFIER = re.compile(r"\b[A-Za-z_]\w*\b")
+# A finding is expected through the monitor (Expect, ExpectEachCommand...), or by comparing what was reported.
+EXPECTATION = re.compile(r"\b(?:\w*Expect\w*|CHECK\w*|REQUIRE\w*)\s*\(")
+
+
+_definitions = {}  # (path, name) -> text: many tests of one file use the same names
+
+
+def definition(case, name, outside):
+    """The text of the definition of name in the test's file outside test bodies (a constant, a table, a
+    function, a struct), or ''. outside: the (start, end) ranges of the file's test bodies."""
+    key = (case.path, name)
+    if key not in _definitions:
+        _definitions[key] = find_definition(case.shape, case.code, name, outside)
+    return _definitions[key]
+
+
+def find_definition(shape, code, name, outside):
+    pattern = re.compile(r"\b(?:struct\s+|class\s+)?" + re.escape(name) +
+                         r"\b\s*(?:\[[^\]]*\]\s*)?(=|\{|\((?=[^;{}]*\)\s*(?:const\s*)?(?:->[^{;]*)?\{))")
+    for match in pattern.finditer(shape):
+        if any(start <= match.start() < end for start, end in outside):
+            continue
+        before = shape[max(0, match.start() - 80):match.start()].rstrip()
+        declared = re.search(r"(?:[\w*&>]|\bstruct|\bclass)$", before)
+        if not declared or re.search(r"(?:->|::|\b(?:return|case|namespace))$", before):
+            continue  # no type before it: a use (an argument, a member, an assignment, a return)
+        if match.group(1) == "=":
+            # Up to the ';' that ends it, or to the bracket that closes around it (a parameter's default).
+            depth, i = 0, match.end()
+            while i < len(shape) and not (depth == 0 and shape[i] in ";,") and depth >= 0:
+                depth += 1 if shape[i] in "([{" else -1 if shape[i] in ")]}" else 0
+                i += 1
+            return code[match.start():i]
+        open_pos = shape.find("{", match.start()) if match.group(1) == "(" else match.start(1)
+        close = matching(shape, open_pos)
+        return code[match.start():close or len(code)]
+    return ""
+
+
+def statements(text):
+    """The text cut at ';', '{' and '}' outside parentheses (so a CHECK holding a braced list stays whole):
+    close enough to C++ statements for finding expectations."""
+    parts, start, depth, i, n = [], 0, 0, 0, len(text)
+    while i < n:
+        c = text[i]
+        if c in "\"'":
+            i += 1
+            while i < n and text[i] != c:
+                i += 2 if text[i] == "\\" else 1
+        elif c in "([":
+            depth += 1
+        elif c in ")]":
+            depth = max(0, depth - 1)
+        elif c in ";{}" and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+        i += 1
+    parts.append(text[start:])
+    return [part for part in parts if part.strip()]
+
+
+def local_values(body, name):
+    """The statements of a test body that give the local name a value: its declaration (a for-loop header
+    included), assignments, and push_back/emplace_back into it."""
+    value = re.compile(r"(?:[\w*&>]\s+" + re.escape(name) + r"\s*[:=({\[]|(?<![\w.>])" + re.escape(name) +
+                       r"\s*(?:=(?!=)|\.(?:push_back|emplace_back)\s*\())")
+    return "\n".join(statement for statement in statements(body) if value.search(statement))
+
+
+def expected_text(case, bodies, depth=3):
+    """What the firing test's expectations (Expect..., CHECK, REQUIRE) can name: the expectation statements of
+    its body; the definitions of the names they use (a constant such as kVuid, a table such as Rules(),
+    through a local such as a loop variable); and the expectations inside the file's helpers that the body
+    calls. Followed depth levels deep, within the test's own file."""
+    found, seen_values, seen_code = [], set(), set()
+    code, values = [case.body], []  # code: only its expectations count; values: all they hold can be expected
+    for _ in range(depth):
+        names, helpers = set(), set()
+        for text in values:
+            names |= set(IDENTIFIER.findall(text))
+        for text in code:
+            for statement in statements(text):
+                if EXPECTATION.search(statement):
+                    found.append(statement)
+                    names |= set(IDENTIFIER.findall(statement))
+                else:
+                    helpers |= set(IDENTIFIER.findall(statement))
+        code, values = [], []
+        for name in sorted(names - seen_values):
+            seen_values.add(name)
+            text = definition(case, name, bodies) or local_values(case.body, name)
+            if text:
+                found.append(text)
+                values.append(text)
+        for name in sorted(helpers - seen_code):
+            seen_code.add(name)
+            text = definition(case, name, bodies)
+            if text:
+                code.append(text)
+        if not code and not values:
+            break
+    return "\n".join(found)
+
+
+def mentions(text, vuid):
+    """vuid in full, or its suffix after the command or structure name (e.g. pInfos-03710), as a whole word."""
+    suffix = vuid.split("-", 2)[2]
+    return re.search(r"(?<![\w-])(?:" + re.escape(vuid) + "|" + re.escape(suffix) + r")(?![\w-])", text) is not None
+
+
+def firing_test_problem(vuid, test, case, bodies):
+    """Why the firing test does not really expect vuid, or None when it does."""
+    if not EXPECTATION.search(case.body):
+        return f"its firing test {test!r} ({case.path}) expects no finding (no Expect/CHECK/REQUIRE)"
+    if not mentions(expected_text(case, bodies), vuid):
+        return (f"its firing test {test!r} ({case.path}) expects findings but never {vuid} (nor its suffix): no "
+                f"Expect/CHECK/REQUIRE in its body, or in its file's helpers it calls, names it directly or "
+                f"through a constant or table")
+    return None
 
 
 def validate(registry, family_names, newest, older, sources):
     errors = []
-    names = test_case_names(sources)
+    cases = test_cases(sources)
+    names = {name: case.path for name, case in cases.items()}
+    bodies = {}
+    for case in cases.values():
+        bodies.setdefault(case.path, []).append((case.body_start, case.body_end))
     seen = set()
     for entry in registry["checks"]:
         vuid = entry["vuid"]
@@ -102,6 +302,11 @@ def validate(registry, family_names, newest, older, sources):
                 errors.append(f"{where}: a checked VUID needs a firing test and a valid twin")
             if not any(vuid in text for text in sources.values()):
                 errors.append(f"{where}: no test source names this VUID")
+            firing = (entry.get("tests") or [None])[0]
+            if firing in cases:
+                problem = firing_test_problem(vuid, firing, cases[firing], bodies[cases[firing].path])
+                if problem:
+                    errors.append(f"{where}: {problem}")
     return errors
 
 

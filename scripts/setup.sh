@@ -5,7 +5,7 @@ set -euo pipefail
 
 # Packages from bookworm itself.
 BASE_PKGS=(g++ cmake ninja-build pkg-config python3 libvulkan-dev vulkan-tools glslang-tools
-           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev)
+           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev nlohmann-json3-dev)
 # Packages that must come from bookworm-backports: lavapipe with ray tracing (bookworm's 22.3 has
 # none) and Catch2 3 (bookworm has only Catch2 2).
 BACKPORT_PKGS=(mesa-vulkan-drivers catch2)

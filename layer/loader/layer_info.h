@@ -7,7 +7,11 @@
 namespace asval {
 
 inline constexpr const char* kLayerDescription = "asval: validates acceleration-structure commands";
-inline constexpr uint32_t kLayerImplementationVersion = 1;
+// From CMake (layer/loader/CMakeLists.txt), which writes the same number into the manifests.
+#ifndef ASVAL_IMPLEMENTATION_VERSION
+#error "ASVAL_IMPLEMENTATION_VERSION is defined by layer/loader/CMakeLists.txt"
+#endif
+inline constexpr uint32_t kLayerImplementationVersion = ASVAL_IMPLEMENTATION_VERSION;
 inline constexpr uint32_t kLayerSpecVersion = VK_HEADER_VERSION_COMPLETE;
 
 // Instance extensions the layer implements itself.

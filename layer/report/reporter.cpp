@@ -5,8 +5,8 @@
 
 #include <cinttypes>
 #include <cstring>
+#include <nlohmann/json.hpp>
 
-#include "json_escape.h"
 #include "vk_enum_string.h"
 #include "vuid_table.h"
 
@@ -20,6 +20,22 @@ std::string Hex(uint64_t v) {
   char buf[24];
   std::snprintf(buf, sizeof(buf), "0x%" PRIx64, v);
   return buf;
+}
+
+spdlog::level::level_enum LogLevel(Severity severity) {
+  switch (severity) {
+    case Severity::kError: return spdlog::level::err;
+    case Severity::kWarning: return spdlog::level::warn;
+    case Severity::kInfo: break;
+  }
+  return spdlog::level::info;
+}
+
+// One line of the report file. Keys keep their insertion order (ordered_json), so lines read as before.
+// Object names come from the app and need not be UTF-8: replace turns invalid bytes into U+FFFD instead of
+// writing a line no JSON parser accepts (or throwing); valid UTF-8 is written as is, not \u-escaped.
+std::string JsonLine(const nlohmann::ordered_json& value) {
+  return value.dump(-1, ' ', /*ensure_ascii=*/false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace
@@ -100,7 +116,7 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
   if (filter_.Mutes(vuid, hash)) return false;
   bool last = false;
   if (!CountDuplicate(hash, &last)) return false;
-  (severity == Severity::kError ? error_count_ : warning_count_).fetch_add(1, std::memory_order_relaxed);
+  CounterFor(severity).fetch_add(1, std::memory_order_relaxed);
 
   const VuidInfo* info = FindVuid(vuid);
   const std::string_view spec_text = info ? std::string_view(info->spec_text) : std::string_view();
@@ -177,67 +193,58 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
     }
   }
   if (!delivered || settings_.log_to_stderr) {
-    stderr_logger_->log(severity == Severity::kError     ? spdlog::level::err
-                        : severity == Severity::kWarning ? spdlog::level::warn
-                                                         : spdlog::level::info,
-                        text);
+    stderr_logger_->log(LogLevel(severity), text);
   }
   WriteJson(severity, vuid, hash, loc, objects, message, spec_text);
   return skip;
+}
+
+std::atomic<uint64_t>& Reporter::CounterFor(Severity severity) {
+  switch (severity) {
+    case Severity::kError: return error_count_;
+    case Severity::kWarning: return warning_count_;
+    case Severity::kInfo: break;
+  }
+  return info_count_;
 }
 
 void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
                          std::initializer_list<ReportObject> objects, std::string_view message,
                          std::string_view spec_text) {
   if (!json_file_) return;
-  std::string line = "{\"severity\":";
-  AppendJsonString(&line, SeverityName(severity));
-  line.append(",\"vuid\":");
-  AppendJsonString(&line, vuid);
-  line.append(",\"message_id\":");
-  AppendJsonString(&line, Hex(hash));
-  line.append(",\"function\":");
-  AppendJsonString(&line, loc.Function());
-  line.append(",\"location\":");
-  AppendJsonString(&line, loc.Path());
-  line.append(",\"objects\":[");
-  bool first = true;
+  nlohmann::ordered_json json_objects = nlohmann::ordered_json::array();
   for (const ReportObject& o : objects) {
     if (o.handle == 0) continue;
-    if (!first) line.push_back(',');
-    first = false;
-    line.append("{\"type\":");
-    AppendJsonString(&line, ObjectTypeName(o.type));
-    line.append(",\"handle\":");
-    AppendJsonString(&line, Hex(o.handle));
+    nlohmann::ordered_json object = {{"type", ObjectTypeName(o.type)}, {"handle", Hex(o.handle)}};
     const std::string name = ObjectName(o.handle);
-    if (!name.empty()) {
-      line.append(",\"name\":");
-      AppendJsonString(&line, name);
-    }
-    line.push_back('}');
+    if (!name.empty()) object["name"] = name;
+    json_objects.push_back(std::move(object));
   }
-  line.append("],\"message\":");
-  AppendJsonString(&line, message);
-  line.append(",\"spec_text\":");
-  AppendJsonString(&line, spec_text);
-  line.append("}\n");
-  std::lock_guard lock(json_mutex_);
-  std::fwrite(line.data(), 1, line.size(), json_file_);
-  std::fflush(json_file_);  // a crash of the app must not lose what was already found
+  const nlohmann::ordered_json line = {
+      {"severity", SeverityName(severity)},
+      {"vuid", vuid},
+      {"message_id", Hex(hash)},
+      {"function", loc.Function()},
+      {"location", loc.Path()},
+      {"objects", std::move(json_objects)},
+      {"message", message},
+      {"spec_text", spec_text},
+  };
+  WriteLine(JsonLine(line));
 }
 
 void Reporter::LayerNotice(Severity severity, std::string_view text) {
-  stderr_logger_->log(severity == Severity::kError ? spdlog::level::err : spdlog::level::warn, text);
+  stderr_logger_->log(LogLevel(severity), text);
   if (!json_file_) return;
-  std::string line = "{\"severity\":";
-  AppendJsonString(&line, SeverityName(severity));
-  line.append(",\"vuid\":\"ASVAL-layer-notice\",\"message\":");
-  AppendJsonString(&line, text);
-  line.append("}\n");
+  const nlohmann::ordered_json line = {
+      {"severity", SeverityName(severity)}, {"vuid", "ASVAL-layer-notice"}, {"message", text}};
+  WriteLine(JsonLine(line));
+}
+
+void Reporter::WriteLine(const std::string& line) {
   std::lock_guard lock(json_mutex_);
   std::fwrite(line.data(), 1, line.size(), json_file_);
-  std::fflush(json_file_);
+  std::fflush(json_file_);  // a crash of the app must not lose what was already found
 }
 
 }  // namespace asval

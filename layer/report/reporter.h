@@ -65,9 +65,10 @@ class Reporter {
   bool Report(Severity severity, std::string_view vuid, const Location& loc,
               std::initializer_list<ReportObject> objects, std::string_view message);
 
-  // Findings delivered so far (after filters and limits), for summaries and tests.
+  // Findings delivered so far (after filters and limits), by severity, for summaries and tests.
   uint64_t ErrorCount() const { return error_count_.load(std::memory_order_relaxed); }
   uint64_t WarningCount() const { return warning_count_.load(std::memory_order_relaxed); }
+  uint64_t InfoCount() const { return info_count_.load(std::memory_order_relaxed); }
 
   // A line for the layer's own problems (bad settings, internal failures): stderr and the report file.
   void LayerNotice(Severity severity, std::string_view text);
@@ -85,8 +86,10 @@ class Reporter {
   // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
   bool CountDuplicate(uint32_t hash, bool* last);
   std::string ObjectName(uint64_t handle) const;
+  std::atomic<uint64_t>& CounterFor(Severity severity);
   void WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
                  std::initializer_list<ReportObject> objects, std::string_view message, std::string_view spec_text);
+  void WriteLine(const std::string& line);  // one JSON line to the report file, flushed
 
   const ReportSettings settings_;
   const MessageFilter filter_;
@@ -106,6 +109,7 @@ class Reporter {
   std::shared_ptr<spdlog::logger> stderr_logger_;
   std::atomic<uint64_t> error_count_{0};
   std::atomic<uint64_t> warning_count_{0};
+  std::atomic<uint64_t> info_count_{0};
 };
 
 }  // namespace asval

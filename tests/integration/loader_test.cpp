@@ -4,6 +4,8 @@
 
 #include <catch2/catch_test_macros.hpp>
 #include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -34,6 +36,53 @@ TEST_CASE("the layer is listed with its instance extensions", "[integration][loa
   for (const VkExtensionProperties& e : exts) names.push_back(e.extensionName);
   CHECK(std::find(names.begin(), names.end(), "VK_EXT_debug_utils") != names.end());
   CHECK(std::find(names.begin(), names.end(), "VK_EXT_layer_settings") != names.end());
+}
+
+VkLayerProperties FindAsval(const std::vector<VkLayerProperties>& layers) {
+  for (const VkLayerProperties& l : layers) {
+    if (std::strcmp(l.layerName, "VK_LAYER_ASVAL_as_validation") == 0) return l;
+  }
+  FAIL("VK_LAYER_ASVAL_as_validation is not listed");
+  return {};
+}
+
+TEST_CASE("the manifest's implementation_version is what the loader and the layer itself report",
+          "[integration][loader]") {
+  Fixture f;
+  // The library the loader loaded, and the manifest next to it that named it (the build tree's).
+  Dl_info info{};
+  REQUIRE(dladdr(reinterpret_cast<void*>(vkGetDeviceProcAddr(f.device().handle(), "vkCmdBuildAccelerationStructuresKHR")),
+                 &info));
+  REQUIRE(info.dli_fname);
+  const std::string library = info.dli_fname;
+  const std::string manifest_path = library.substr(0, library.rfind('/') + 1) + "VkLayer_asval_as_validation.json";
+  std::ifstream in(manifest_path);
+  REQUIRE(in);
+  const std::string text = nlohmann::json::parse(in)["layer"]["implementation_version"].get<std::string>();
+  INFO(manifest_path << ": implementation_version \"" << text << "\"");
+  // The loader reads the string with atoi: only a plain decimal number means what it says.
+  REQUIRE(!text.empty());
+  REQUIRE(text.find_first_not_of("0123456789") == std::string::npos);
+  const uint32_t version = static_cast<uint32_t>(std::stoul(text));
+
+  // What the loader answers (from the manifest).
+  uint32_t count = 0;
+  REQUIRE(vkEnumerateInstanceLayerProperties(&count, nullptr) == VK_SUCCESS);
+  std::vector<VkLayerProperties> layers(count);
+  REQUIRE(vkEnumerateInstanceLayerProperties(&count, layers.data()) == VK_SUCCESS);
+  CHECK(FindAsval(layers).implementationVersion == version);
+
+  // What the layer answers itself (compiled in): its exported introspection function.
+  void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_NOLOAD);
+  REQUIRE(handle);
+  auto own = reinterpret_cast<PFN_vkEnumerateInstanceLayerProperties>(dlsym(handle, "vkEnumerateInstanceLayerProperties"));
+  REQUIRE(own);
+  count = 1;
+  VkLayerProperties props{};
+  CHECK(own(&count, &props) == VK_SUCCESS);
+  CHECK(std::string(props.layerName) == "VK_LAYER_ASVAL_as_validation");
+  CHECK(props.implementationVersion == version);
+  dlclose(handle);
 }
 
 TEST_CASE("intercepted commands resolve into the layer, aliases included", "[integration][loader]") {
