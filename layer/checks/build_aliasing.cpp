@@ -205,12 +205,31 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
 
 // Sort by (space, begin), then sweep keeping the spans that reach past the current one's start: each pair
 // met is an overlap. With no overlaps the active list holds at most one span, so the sweep is linear.
+bool SpanBefore(const AccessSpan& x, const AccessSpan& y) {
+  if (x.space != y.space) return x.space < y.space;
+  if (x.begin != y.begin) return x.begin < y.begin;
+  return x.info < y.info;
+}
+
+// Up to this many spans (one info: a destination, a source, a scratch) an insertion sort in place, which is
+// what std::sort does for so few elements (the same order, ties included), without its call and setup.
+constexpr size_t kFewSpans = 16;
+
+void SortSpans(std::vector<AccessSpan>& spans) {
+  if (spans.size() > kFewSpans) {
+    std::sort(spans.begin(), spans.end(), SpanBefore);
+    return;
+  }
+  for (size_t k = 1; k < spans.size(); ++k) {
+    const AccessSpan moving = spans[k];
+    size_t to = k;
+    for (; to > 0 && SpanBefore(moving, spans[to - 1]); --to) spans[to] = spans[to - 1];
+    spans[to] = moving;
+  }
+}
+
 bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
-  std::sort(w.spans.begin(), w.spans.end(), [](const AccessSpan& x, const AccessSpan& y) {
-    if (x.space != y.space) return x.space < y.space;
-    if (x.begin != y.begin) return x.begin < y.begin;
-    return x.info < y.info;
-  });
+  SortSpans(w.spans);
   bool skip = false;
   int findings = 0;
   w.active.clear();

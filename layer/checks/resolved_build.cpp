@@ -1,5 +1,7 @@
 #include "resolved_build.h"
 
+#include <new>
+
 #include "build_size_lookup.h"
 
 namespace asval {
@@ -59,15 +61,21 @@ void Place(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, BufferM
 
 }  // namespace
 
-ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd) : w_(TakeThreadWorkspace()) {
-  if (!w_) {
-    owned_ = std::make_unique<ResolvedWorkspace>();
-    w_ = owned_.get();
+ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd) {
+  const uint32_t count = cmd.infos ? cmd.info_count : 0;
+  if (count <= kInlineInfos) {
+    for (; inline_count_ < count; ++inline_count_) new (&inline_.infos[inline_count_]) ResolvedInfo();
+    infos_ = inline_.infos;
+  } else {
+    w_ = TakeThreadWorkspace();
+    if (!w_) {
+      owned_ = std::make_unique<ResolvedWorkspace>();
+      w_ = owned_.get();
+    }
+    w_->infos.clear();
+    w_->infos.resize(count);
+    infos_ = w_->infos.data();
   }
-  std::vector<ResolvedInfo>& infos = w_->infos;
-  infos.clear();
-  infos.resize(cmd.infos ? cmd.info_count : 0);
-  infos_ = infos.data();
   if (!cmd.infos) return;
   const bool records = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckHandles | kCheckAddresses | kCheckAliasing));
   const bool placement = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckAddresses | kCheckAliasing));
@@ -79,15 +87,16 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd) :
   }
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-    ResolvedInfo& r = infos[i];
+    ResolvedInfo& r = infos_[i];
     r.dst = FindStructure(ctx.state, info.dstAccelerationStructure);
     r.src = FindStructure(ctx.state, info.srcAccelerationStructure);
-    if (placement) Place(ctx, cmd, i, *memo_, i > 0 ? infos[i - 1].sizes : std::nullopt, r);
+    if (placement) Place(ctx, cmd, i, *memo_, i > 0 ? infos_[i - 1].sizes : std::nullopt, r);
   }
 }
 
 ResolvedBuild::~ResolvedBuild() {
-  if (!owned_) w_->in_use = false;
+  for (uint32_t k = 0; k < inline_count_; ++k) inline_.infos[k].~ResolvedInfo();
+  if (w_ && !owned_) w_->in_use = false;
 }
 
 }  // namespace asval

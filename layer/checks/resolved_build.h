@@ -40,7 +40,8 @@ struct ResolvedInfo {
 struct ResolvedWorkspace;
 
 // The view of one call. Lives on the hook's stack for the duration of the validation; its per-info records
-// live in a per-thread buffer that keeps its capacity, so a steady stream of calls allocates nothing.
+// live there too for small calls, else in a per-thread buffer that keeps its capacity, so a steady stream of
+// calls allocates nothing.
 class ResolvedBuild {
  public:
   ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd);
@@ -55,7 +56,15 @@ class ResolvedBuild {
   BufferMemo& memo() const { return *memo_; }
 
  private:
-  ResolvedWorkspace* w_;
+  // Calls of up to this many infos keep their records on the stack (no per-thread lookup, no vector).
+  static constexpr uint32_t kInlineInfos = 2;
+  union Inline {
+    Inline() {}
+    ~Inline() {}
+    ResolvedInfo infos[kInlineInfos];
+  } inline_;
+  uint32_t inline_count_ = 0;  // records constructed in inline_
+  ResolvedWorkspace* w_ = nullptr;
   std::unique_ptr<ResolvedWorkspace> owned_;  // only when the thread's workspace is already in use
   ResolvedInfo* infos_ = nullptr;
   BufferMemo* memo_ = nullptr;
