@@ -4,12 +4,15 @@
 //   valgrind --tool=callgrind --instr-atstart=no ./record_builds 20000
 // with and without VK_INSTANCE_LAYERS=VK_LAYER_ASVAL_as_validation gives the instructions per call that the
 // layer adds (the difference of the two totals divided by N). Arguments: calls, infos per call, geometries per
-// info. See docs/performance.md.
+// info, and optionally "own" (every info gets a scratch buffer of its own instead of a slice of one shared buffer)
+// or "own-inputs" (also its own vertex buffer and its own geometry and range arrays, as an app building many
+// meshes does; without it the infos share one vertex buffer and one geometry array). See docs/performance.md.
 #include <valgrind/callgrind.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "vkkit.h"
@@ -18,6 +21,8 @@ int main(int argc, char** argv) {
   const int calls = argc > 1 ? std::atoi(argv[1]) : 20000;
   const uint32_t infos_per_call = argc > 2 ? static_cast<uint32_t>(std::atoi(argv[2])) : 1;
   const uint32_t geometries_per_info = argc > 3 ? static_cast<uint32_t>(std::atoi(argv[3])) : 1;
+  const bool own_inputs = argc > 4 && std::strcmp(argv[4], "own-inputs") == 0;
+  const bool own_buffers = own_inputs || (argc > 4 && std::strcmp(argv[4], "own") == 0);
   vkkit::InstanceOptions options;  // layers from VK_INSTANCE_LAYERS
   vkkit::Instance instance(options);
   VkPhysicalDevice gpu = instance.FindRayTracingGpu();
@@ -42,13 +47,36 @@ int main(int argc, char** argv) {
   vkkit::Buffer scratch = device.CreateBuffer(slice * infos_per_call, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   std::vector<vkkit::AccelerationStructure> destinations;
   std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos(infos_per_call, info);
+  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> ranges(infos_per_call, geometry_ranges.data());
+  // "own": per info, a scratch buffer; "own-inputs": also a vertex buffer (a copy of the triangle) and
+  // geometry and range arrays.
+  std::vector<vkkit::Buffer> own;
+  std::vector<std::vector<VkAccelerationStructureGeometryKHR>> own_geometries;
+  std::vector<std::vector<VkAccelerationStructureBuildRangeInfoKHR>> own_ranges;
   for (uint32_t k = 0; k < infos_per_call; ++k) {
     destinations.push_back(
         device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize));
     infos[k].dstAccelerationStructure = destinations.back().handle;
     infos[k].scratchData.deviceAddress = scratch.address + slice * k;
+    if (!own_buffers) continue;
+    vkkit::Buffer own_scratch = device.CreateBuffer(slice, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    infos[k].scratchData.deviceAddress = own_scratch.address;
+    own.push_back(own_scratch);
+    if (!own_inputs) continue;
+    vkkit::Buffer own_vertices =
+        device.CreateBuffer(build.vertices.size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+    std::memcpy(own_vertices.mapped, build.vertices.mapped, build.vertices.size);
+    own_geometries.push_back(geometries);
+    for (VkAccelerationStructureGeometryKHR& g : own_geometries.back()) {
+      g.geometry.triangles.vertexData.deviceAddress = own_vertices.address;
+    }
+    own_ranges.push_back(geometry_ranges);
+    own.push_back(own_vertices);
   }
-  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> ranges(infos_per_call, geometry_ranges.data());
+  for (uint32_t k = 0; own_inputs && k < infos_per_call; ++k) {  // after the pushes: the arrays stay put now
+    infos[k].pGeometries = own_geometries[k].data();
+    ranges[k] = own_ranges[k].data();
+  }
 
   double seconds = 0;
   device.OneShot(
@@ -62,9 +90,10 @@ int main(int argc, char** argv) {
         seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       },
       /*submit=*/false);
-  std::printf("%d calls x %u infos x %u geometries: %.1f ns per call\n", calls, infos_per_call, geometries_per_info,
-              seconds * 1e9 / calls);
+  std::printf("%d calls x %u infos x %u geometries%s: %.1f ns per call\n", calls, infos_per_call,
+              geometries_per_info, own_inputs ? " (own buffers and arrays)" : own_buffers ? " (own scratch buffers)" : "", seconds * 1e9 / calls);
   for (vkkit::AccelerationStructure& as : destinations) device.Destroy(as);
+  for (vkkit::Buffer& b : own) device.Destroy(b);
   device.Destroy(scratch);
   build.Release(device);
   return 0;

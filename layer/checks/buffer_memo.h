@@ -1,11 +1,15 @@
 #pragma once
 // The buffers recent build commands have looked up. A recorded build reads many ranges of the same few
 // buffers: one vertex buffer for many geometries, one scratch buffer sliced per info, one storage buffer
-// holding many structures; a frame records the same buffers call after call. The memo keeps the last few
+// holding many structures; a frame records the same buffers call after call. The memo keeps up to kEntries
 // buffers found (their address range, usage and memory binding), so each is looked up in the shared maps
 // (locks, hashing) once rather than once per range. One memo per thread, kept from call to call: Sync, at
 // the start of each call, empties it unless the device's buffer map and address map are the very ones it
 // was filled from and have not changed since (their change stamps), so it never serves a stale record.
+// Entries are found through two direct-mapped indexes, by the start address a lookup asked for and by
+// handle, so a call over many buffers (16 infos with a scratch and a vertex buffer each, and their
+// destinations' buffers) finds each in a few instructions, without a scan and without evicting the others;
+// a memo that fills up starts over.
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -18,6 +22,7 @@ namespace asval {
 
 struct KnownBuffer {
   VkBuffer buffer = VK_NULL_HANDLE;
+  uint64_t id = 0;  // BufferState::id: which buffer of that handle value
   VkDeviceAddress base = 0;  // device address range [base, base + size); size 0: the buffer has none
   VkDeviceSize size = 0;
   VkBufferUsageFlags usage = 0;
@@ -63,30 +68,44 @@ class BufferMemo {
     if (buffers == buffers_stamp_ && addresses == addresses_stamp_) return;
     buffers_stamp_ = buffers;
     addresses_stamp_ = addresses;
-    count_ = 0;
-    next_ = 0;
-    last_ = 0;
-    before_ = 0;
-    entries_[0] = KnownBuffer{};  // Held tries entries_[last_] and entries_[before_] before looking at count_
+    Reset();
   }
   // The record of `buffer`; false when the layer does not know the buffer.
   bool Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* out);
+  // The buffer `structure` was created on; false when it is unknown or was destroyed (even if a new buffer
+  // now has its handle value: structure_memory.h).
+  bool FindOfStructure(const DeviceState& state, const AccelerationStructureState& structure, KnownBuffer* out) {
+    return Find(state, structure.buffer, out) && out->id == structure.buffer_id;
+  }
 
  private:
-  static constexpr int kEntries = 32;
+  static constexpr int kEntries = 128;
+  static constexpr unsigned kSlots = 256;  // per index; a slot holds entry + 1 (0: empty)
+  static_assert(kEntries < 256, "slots hold entry indexes in a byte");
+  static unsigned SlotOf(uint64_t key) { return static_cast<unsigned>((key * 0x9e3779b97f4a7c15ull) >> 56); }
   static bool Serves(const KnownBuffer& e, VkDeviceAddress address, VkDeviceSize bytes, VkBufferUsageFlags usage) {
     return (e.usage & usage) == usage && e.Holds(address, bytes == 0 ? 1 : bytes);
   }
   const KnownBuffer* HeldSlow(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
                               VkBufferUsageFlags usage);
-  // Stores an entry; returns its index.
+  // Makes `entry` the answer Held gives first and returns it.
+  const KnownBuffer* Answer(int entry) {
+    before_ = last_;
+    last_ = entry;
+    return &entries_[entry];
+  }
+  // Stores an entry (starting over when full); returns its index.
   int Remember(const KnownBuffer& entry);
+  void Reset();
 
   std::array<KnownBuffer, kEntries> entries_{};
   int count_ = 0;
-  int next_ = 0;  // round-robin replacement once full
   int last_ = 0;    // the entry Held returned last
   int before_ = 0;  // and the one before it
+  std::array<uint64_t, kSlots> address_keys_{};  // the start address a lookup asked for
+  std::array<uint8_t, kSlots> address_entries_{};
+  std::array<uint64_t, kSlots> handle_keys_{};
+  std::array<uint8_t, kSlots> handle_entries_{};
   StampValue buffers_stamp_;    // the maps the entries come from, as they were (id 0: none yet)
   StampValue addresses_stamp_;
 };

@@ -224,8 +224,8 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
   return skip;
 }
 
-bool ValidateScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
-  // No size (counted by SizesOfInfo), or a zero size: no scratch is read or written.
+bool ValidateScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
+  // No size (counted by ValidateBuildMemory), or a zero size: no scratch is read or written.
   if (r.scratch_bytes == 0 || r.scratch_in_storage) return false;
   return ReportScratch(ctx, cmd, i, r.scratch_bytes);
 }
@@ -268,7 +268,7 @@ bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, ui
 
 }  // namespace
 
-bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                            BufferMemo& memo) {
   bool skip = ValidateInfoSizes(ctx, cmd, i, r);
   if (cmd.is_host()) return skip;  // host addresses: build_host.h

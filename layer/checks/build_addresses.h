@@ -14,13 +14,13 @@
 // Host builds use host addresses: their rules are in build_host.h. Sizes and limits: build_sizes.h.
 #include "buffer_memo.h"
 #include "build_command.h"
-#include "build_memory_pass.h"
+#include "resolved_build.h"
 #include "check_context.h"
 
 namespace asval {
 
 // The rules above, plus those of build_sizes.h, for pInfos[i] (called by ValidateBuildMemory).
-bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                            BufferMemo& memo);
 
 }  // namespace asval

@@ -123,17 +123,23 @@ bool StructureSpan(const AccelerationStructureState& structure, const KnownBuffe
   return true;
 }
 
+// Same, for a structure whose buffer is not resolved yet (null: not a live structure).
+bool StructureSpan(const DeviceState& state, BufferMemo& memo, const AccelerationStructureState* structure,
+                   VkDeviceSize accessed, uint32_t info, SpanKind kind, AccessSpan* out) {
+  KnownBuffer buffer;
+  if (!structure || !memo.FindOfStructure(state, *structure, &buffer)) return false;
+  return StructureSpan(*structure, buffer, accessed, info, kind, out);
+}
+
 // Same, for a structure known by handle only.
 bool StructureSpan(const DeviceState& state, BufferMemo& memo, VkAccelerationStructureKHR handle, VkDeviceSize accessed,
                    uint32_t info, SpanKind kind, AccessSpan* out) {
   const std::optional<std::shared_ptr<const AccelerationStructureState>> structure =
       state.acceleration_structures.find(handle);
-  KnownBuffer buffer;
-  if (!structure || !*structure || !memo.Find(state, (*structure)->buffer, &buffer)) return false;
-  return StructureSpan(**structure, buffer, accessed, info, kind, out);
+  return structure && StructureSpan(state, memo, structure->get(), accessed, info, kind, out);
 }
 
-bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                  BufferMemo& memo, AccessSpan* out) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (cmd.is_host()) {
@@ -156,10 +162,10 @@ bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, 
 }
 
 // The spans pInfos[i] accesses. Each one the layer cannot place is left out and counted.
-void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                   BufferMemo& memo, Workspace& w) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  if (!r.sizes) return;  // counted by SizesOfInfo
+  if (!r.sizes) return;  // counted by ValidateBuildMemory
   AccessSpan span;
   if (r.dst && r.dst_buffer_known &&
       StructureSpan(*r.dst, r.dst_buffer, r.sizes->acceleration_structure_size, i, SpanKind::kDst, &span)) {
@@ -168,8 +174,8 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
     CountUnknownState(ctx);
   }
   if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR && info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    if (StructureSpan(ctx.state, memo, info.srcAccelerationStructure, r.sizes->acceleration_structure_size, i,
-                      SpanKind::kSrc, &span)) {
+    if (StructureSpan(ctx.state, memo, r.src.get(), r.sizes->acceleration_structure_size, i, SpanKind::kSrc,
+                      &span)) {
       w.spans.push_back(span);
     } else {
       CountUnknownState(ctx);
@@ -199,12 +205,31 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
 
 // Sort by (space, begin), then sweep keeping the spans that reach past the current one's start: each pair
 // met is an overlap. With no overlaps the active list holds at most one span, so the sweep is linear.
+bool SpanBefore(const AccessSpan& x, const AccessSpan& y) {
+  if (x.space != y.space) return x.space < y.space;
+  if (x.begin != y.begin) return x.begin < y.begin;
+  return x.info < y.info;
+}
+
+// Up to this many spans (one info: a destination, a source, a scratch) an insertion sort in place, which is
+// what std::sort does for so few elements (the same order, ties included), without its call and setup.
+constexpr size_t kFewSpans = 16;
+
+void SortSpans(std::vector<AccessSpan>& spans) {
+  if (spans.size() > kFewSpans) {
+    std::sort(spans.begin(), spans.end(), SpanBefore);
+    return;
+  }
+  for (size_t k = 1; k < spans.size(); ++k) {
+    const AccessSpan moving = spans[k];
+    size_t to = k;
+    for (; to > 0 && SpanBefore(moving, spans[to - 1]); --to) spans[to] = spans[to - 1];
+    spans[to] = moving;
+  }
+}
+
 bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
-  std::sort(w.spans.begin(), w.spans.end(), [](const AccessSpan& x, const AccessSpan& y) {
-    if (x.space != y.space) return x.space < y.space;
-    if (x.begin != y.begin) return x.begin < y.begin;
-    return x.info < y.info;
-  });
+  SortSpans(w.spans);
   bool skip = false;
   int findings = 0;
   w.active.clear();
@@ -243,7 +268,7 @@ bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& 
                      reinterpret_cast<uint64_t>(dst.structure), DescribeSpan(dst));
 }
 
-bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                             BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE ||
@@ -253,7 +278,7 @@ bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, ui
   AccessSpan src, dst;
   const VkDeviceSize whole = ~VkDeviceSize{0};
   if (!r.dst || !r.dst_buffer_known || !StructureSpan(*r.dst, r.dst_buffer, whole, i, SpanKind::kDst, &dst) ||
-      !StructureSpan(ctx.state, memo, info.srcAccelerationStructure, whole, i, SpanKind::kSrc, &src)) {
+      !StructureSpan(ctx.state, memo, r.src.get(), whole, i, SpanKind::kSrc, &src)) {
     CountUnknownState(ctx);
     return false;
   }
@@ -328,7 +353,7 @@ AliasingSweep::~AliasingSweep() {
   if (!owned_) w_->in_use = false;
 }
 
-bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                             BufferMemo& memo) {
   CollectSpans(ctx, cmd, i, r, memo, *w_);
   return ValidateUpdateAliasing(ctx, cmd, i, r, memo);

@@ -18,7 +18,7 @@
 
 #include "buffer_memo.h"
 #include "build_command.h"
-#include "build_memory_pass.h"
+#include "resolved_build.h"
 #include "check_context.h"
 
 namespace asval {
@@ -35,7 +35,7 @@ class AliasingSweep {
   AliasingSweep& operator=(const AliasingSweep&) = delete;
   // Collects the spans pInfos[i] accesses (each one the layer cannot place is left out and counted) and
   // checks pInfos-03668 for it.
-  bool AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r,
+  bool AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                BufferMemo& memo);
   // The overlaps among all the spans; for host builds, None-03407.
   bool Finish(const CheckContext& ctx, const BuildCommand& cmd);

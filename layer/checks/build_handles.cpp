@@ -13,16 +13,8 @@ namespace asval {
 
 namespace {
 
-using AsRecord = std::shared_ptr<const AccelerationStructureState>;
-
 // Up to this many infos the duplicate rules compare all pairs (n^2 / 2 compares, no buffer); beyond, they sort.
 constexpr uint32_t kFewInfos = 16;
-
-AsRecord FindStructure(const CheckContext& ctx, VkAccelerationStructureKHR handle) {
-  if (handle == VK_NULL_HANDLE) return nullptr;
-  std::optional<AsRecord> record = ctx.state.acceleration_structures.find(handle);
-  return record ? std::move(*record) : nullptr;
-}
 
 // pInfos-03699 / 03700: the build's type against the type the destination was created with.
 bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
@@ -62,10 +54,10 @@ bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                      reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
 }
 
-bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
-  const AsRecord dst = FindStructure(ctx, info.dstAccelerationStructure);
+  const AccelerationStructureState* dst = r.dst.get();
   if (!dst) {
     skip |= ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
                         [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
@@ -78,7 +70,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
     if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
   }
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    const AsRecord src = FindStructure(ctx, info.srcAccelerationStructure);
+    const AccelerationStructureState* src = r.src.get();
     if (!src) {
       skip |= ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
                           [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
@@ -170,10 +162,10 @@ bool ValidateDistinctHandlesMany(const CheckContext& ctx, const BuildCommand& cm
 
 }  // namespace
 
-bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd) {
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i);
+  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i, resolved.info(i));
   if (cmd.info_count > kFewInfos) {
     skip |= ValidateDistinctHandlesMany(ctx, cmd);
   } else if (cmd.info_count > 1) {

@@ -12,9 +12,11 @@
 // stream of many-info calls allocates nothing.
 #include "build_command.h"
 #include "check_context.h"
+#include "resolved_build.h"
 
 namespace asval {
 
-bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd);
+// The records of each info's structures come from the command's resolved view.
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved);
 
 }  // namespace asval

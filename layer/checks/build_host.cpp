@@ -107,10 +107,14 @@ bool ValidateStructureMemory(const CheckContext& ctx, const BuildCommand& cmd, V
                      needed - (end - begin));
 }
 
-bool ValidateHostScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateHostScratch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  const std::optional<BuildSizes> sizes = SizesOfInfo(ctx, cmd, i);
-  if (!sizes) return false;  // counted: without the size, a null pointer may be all a zero-size scratch needs
+  // The resolved sizes when the memory families had them looked up; else asked here.
+  const std::optional<BuildSizes> sizes = r.placed ? r.sizes : SizesOfInfo(ctx.state, cmd, i);
+  if (!sizes) {
+    CountUnknownState(ctx);
+    return false;  // without the size, a null pointer may be all a zero-size scratch needs
+  }
   const bool update = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
   const VkDeviceSize needed = update ? sizes->update_scratch_size : sizes->build_scratch_size;
   if (needed == 0) return false;
@@ -212,7 +216,7 @@ bool ValidateDeferredOperation(const CheckContext& ctx, const BuildCommand& cmd)
 
 }  // namespace
 
-bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd) {
+bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.is_host() || !cmd.infos) return false;
   std::vector<uint64_t> references;  // instance references of one geometry (host builds are not a hot path)
   bool skip = ValidateDeferredOperation(ctx, cmd);
@@ -225,7 +229,7 @@ bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd) {
       skip |= ValidateStructureMemory(ctx, cmd, info.srcAccelerationStructure,
                                       StructurePlace{i, "srcAccelerationStructure", 0}, kSource);
     }
-    skip |= ValidateHostScratch(ctx, cmd, i);
+    skip |= ValidateHostScratch(ctx, cmd, i, resolved.info(i));
     skip |= ValidateHostInputs(ctx, cmd, i, references);
   }
   return skip;

@@ -13,9 +13,10 @@
 //   deferredOperation-03678        the deferred operation has no earlier host command still running
 #include "build_command.h"
 #include "check_context.h"
+#include "resolved_build.h"
 
 namespace asval {
 
-bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd);
+bool ValidateBuildHost(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved);
 
 }  // namespace asval

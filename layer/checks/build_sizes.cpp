@@ -143,8 +143,8 @@ bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, ui
                      cmd.is_indirect() ? "ppMaxPrimitiveCounts" : "primitive counts", counts, needed - created);
 }
 
-bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
-  if (!r.sizes) return false;  // counted by SizesOfInfo
+bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
+  if (!r.sizes) return false;  // counted by ValidateBuildMemory
   if (!r.dst) {
     CountUnknownState(ctx);  // not a live structure: dstAccelerationStructure-03800 says so
     return false;
@@ -214,20 +214,19 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
   return primitives <= limits.maxPrimitiveCount;
 }
 
-std::optional<BuildSizes> SizesOfInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i) {
   BuildSignature signature;
   BuildSizes sizes;
   if (SignatureOfInfo(cmd, i, &signature)) {
-    if (ctx.state.build_sizes.Find(signature, &sizes)) return sizes;
-    if (SizeQueryIsValid(ctx.state, signature)) {
-      if (std::optional<BuildSizes> queried = ctx.state.build_sizes.Query(signature)) return queried;
+    if (state.build_sizes.Find(signature, &sizes)) return sizes;
+    if (SizeQueryIsValid(state, signature)) {
+      if (std::optional<BuildSizes> queried = state.build_sizes.Query(signature)) return queried;
     }
   }
-  CountUnknownState(ctx);
   return std::nullopt;
 }
 
-bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const InfoResolution& r) {
+bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   return ValidateInstanceCounts(ctx, cmd, i) | ValidateDestinationSize(ctx, cmd, i, r);
 }
 

@@ -8,26 +8,34 @@
 #include "build_ranges.h"
 #include "build_structure.h"
 #include "history_host.h"
+#include "resolved_build.h"
 
 namespace asval {
 
 namespace {
 
 // One line per rule family. Each family function covers all three build commands (BuildCommand::kind
-// says which) and is skipped entirely when the enabled_checks setting leaves its family out.
+// says which) and is skipped entirely when the enabled_checks setting leaves its family out. Families that
+// need each info's structures, sizes or buffers read them from the command's resolved view, looked up once.
 struct BuildFamily {
   LayerSettingFlagBits family;
-  bool (*validate)(const CheckContext& ctx, const BuildCommand& cmd);
+  bool (*validate)(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved);
 };
 
+// For the families that need nothing resolved.
+template <bool (*validate)(const CheckContext&, const BuildCommand&)>
+bool Unresolved(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild&) {
+  return validate(ctx, cmd);
+}
+
 constexpr BuildFamily kBuildFamilies[] = {
-    {kCheckFeatures, &ValidateBuildFeatures},
+    {kCheckFeatures, &Unresolved<&ValidateBuildFeatures>},
     {kCheckHandles, &ValidateBuildHandles},
-    {kCheckStructure, &ValidateBuildStructure},
-    {kCheckStructure, &ValidateBuildRanges},
-    {kCheckAlignment, &ValidateBuildAlignment},
-    {kCheckHistory, &ValidateBuildHistory},  // host builds only; device builds are checked at submission
-    // Addresses and aliasing share one pass: each info's sizes, destination and scratch are looked up once.
+    {kCheckStructure, &Unresolved<&ValidateBuildStructure>},
+    {kCheckStructure, &Unresolved<&ValidateBuildRanges>},
+    {kCheckAlignment, &Unresolved<&ValidateBuildAlignment>},
+    {kCheckHistory, &Unresolved<&ValidateBuildHistory>},  // host builds only; device builds: at submission
+    // Addresses and aliasing share one pass over the resolved sizes, destinations and scratch.
     {kCheckAddressesOrAliasing, &ValidateBuildMemory},
     {kCheckHost, &ValidateBuildHost},
 };
@@ -35,9 +43,10 @@ constexpr BuildFamily kBuildFamilies[] = {
 }  // namespace
 
 bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
+  const ResolvedBuild resolved(ctx, cmd);
   bool skip = false;
   for (const BuildFamily& f : kBuildFamilies) {
-    if (ctx.Enabled(f.family)) skip |= f.validate(ctx, cmd);
+    if (ctx.Enabled(f.family)) skip |= f.validate(ctx, cmd, resolved);
   }
   return skip;
 }

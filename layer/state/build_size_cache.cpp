@@ -7,104 +7,91 @@ namespace asval {
 
 namespace {
 
-// The signature as a stream of 64-bit words, handed to a sink: hashing, comparing and storing all read the
-// app's structures directly, so a lookup needs no buffer of its own.
-template <typename Sink>
-void EmitSignature(const BuildSignature& s, Sink& sink) {
+// The signature as 64-bit words, written to `out` (room for MaxSignatureWords): hashing, comparing and storing
+// all work on these words, read once from the app's structures. Returns the number of words, or 0 when the
+// build is not cacheable (BuildSignature::Cacheable: an extension chain, a null geometry or a geometry type the
+// layer does not know), as soon as that shows: such a build is never stored, so it is never looked up either
+// and pays no hash.
+std::size_t WriteSignature(const BuildSignature& s, uint64_t* out) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = *s.info;
-  // Extension chains are marked (bit 63 and 62), so a signature with one never equals one without: such
-  // builds are never stored (Cacheable), and then never found either.
-  const uint64_t chained = info.pNext ? uint64_t{1} << 63 : 0;
-  sink(chained | (uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(info.type));
-  sink((uint64_t{info.flags} << 32) | info.geometryCount);
+  if (info.pNext) return 0;
+  uint64_t* w = out;
+  *w++ = (uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(info.type);
+  *w++ = (uint64_t{info.flags} << 32) | info.geometryCount;
   // The geometry array and the counts are walked by pointer: Geometry(j) and Count(j) would re-test which
   // array the info uses and multiply the stride for every word.
   const VkAccelerationStructureGeometryKHR* geometries = info.pGeometries;
   const VkAccelerationStructureGeometryKHR* const* geometry_pointers = geometries ? nullptr : info.ppGeometries;
+  if (info.geometryCount != 0 && !geometries && !geometry_pointers) return 0;
   const char* count = reinterpret_cast<const char*>(s.counts);
   for (uint32_t j = 0; j < info.geometryCount; ++j, count += s.count_stride) {
-    const VkAccelerationStructureGeometryKHR* g =
-        geometries ? &geometries[j] : geometry_pointers ? geometry_pointers[j] : nullptr;
-    if (!g) {
-      sink(~uint64_t{0});
-      continue;
-    }
-    const bool data_chained = g->geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g->geometry.triangles.pNext;
-    sink((g->pNext ? uint64_t{1} << 63 : 0) | (data_chained ? uint64_t{1} << 62 : 0) |
-         (uint64_t{static_cast<uint32_t>(g->geometryType)} << 32) | g->flags);
+    const VkAccelerationStructureGeometryKHR* g = geometries ? &geometries[j] : geometry_pointers[j];
+    if (!g || g->pNext) return 0;
+    *w++ = (uint64_t{static_cast<uint32_t>(g->geometryType)} << 32) | g->flags;
     switch (g->geometryType) {
       case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
         const VkAccelerationStructureGeometryTrianglesDataKHR& t = g->geometry.triangles;
-        sink((uint64_t{static_cast<uint32_t>(t.vertexFormat)} << 32) | static_cast<uint32_t>(t.indexType));
-        sink(t.vertexStride);
-        sink((uint64_t{t.maxVertex} << 1) | (t.transformData.deviceAddress != 0 ? 1u : 0u));
+        if (t.pNext) return 0;  // motion vertices, micromaps: the sizes depend on them
+        *w++ = (uint64_t{static_cast<uint32_t>(t.vertexFormat)} << 32) | static_cast<uint32_t>(t.indexType);
+        *w++ = t.vertexStride;
+        *w++ = (uint64_t{t.maxVertex} << 1) | (t.transformData.deviceAddress != 0 ? 1u : 0u);
         break;
       }
       case VK_GEOMETRY_TYPE_AABBS_KHR:
-        sink(g->geometry.aabbs.stride);
+        *w++ = g->geometry.aabbs.stride;
         break;
       case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-        sink(g->geometry.instances.arrayOfPointers);
+        *w++ = g->geometry.instances.arrayOfPointers;
         break;
       default:
-        break;  // not cacheable (BuildSignature::Cacheable), never stored
+        return 0;
     }
-    sink(uint64_t{*reinterpret_cast<const uint32_t*>(count)});
+    *w++ = uint64_t{*reinterpret_cast<const uint32_t*>(count)};
   }
+  return static_cast<std::size_t>(w - out);
 }
 
-// An upper bound of the words EmitSignature hands out: two for the info, at most five per geometry (header,
+// An upper bound of the words WriteSignature writes: two for the info, at most five per geometry (header,
 // three of triangle data, count).
 std::size_t MaxSignatureWords(const BuildSignature& s) { return 2 + std::size_t{5} * s.info->geometryCount; }
 
-// One xor and one multiply per word: the word-by-word compare, not the hash, rules out collisions, and Finish
-// spreads the high bits the multiply leaves unmixed.
-struct HashSink {
+// Room for one signature: on the stack for infos of up to 102 geometries, else a per-thread buffer that keeps
+// its capacity (it grows, once, on the first call of that length on the thread).
+class SignatureWords {
+ public:
+  explicit SignatureWords(const BuildSignature& s) {
+    const std::size_t needed = MaxSignatureWords(s);
+    words_ = needed <= kStackWords ? stack_ : Spill(needed);
+    count_ = WriteSignature(s, words_);
+  }
+  const uint64_t* data() const { return words_; }
+  std::size_t count() const { return count_; }  // 0: not cacheable
+  std::size_t bytes() const { return count_ * sizeof(uint64_t); }
+
+ private:
+  static constexpr std::size_t kStackWords = 512;  // 4 KiB
+  [[gnu::noinline]] static uint64_t* Spill(std::size_t needed) {
+    thread_local std::vector<uint64_t> spill;
+    if (spill.size() < needed) spill.resize(needed);
+    return spill.data();
+  }
+  uint64_t stack_[kStackWords];
+  uint64_t* words_;
+  std::size_t count_;
+};
+
+// One xor and one multiply per word, then fmix64 to spread the last words into the high bits (which pick the
+// shard) and the low ones (the slot of the per-thread table): the word-by-word compare that follows, not the
+// hash, rules out collisions. XXH3_64bits over the same words (header-only, SSE2) was measured instead and costs
+// more instructions: +15 per lookup of a one-geometry build, +3,900 per lookup of a 256-geometry one
+// (docs/performance.md, "One resolved view per build command").
+uint64_t HashOf(const SignatureWords& s) {
   uint64_t h = 0x243f6a8885a308d3ull;
-  void operator()(uint64_t w) { h = (h ^ w) * 0x9e3779b97f4a7c15ull; }
-};
-
-// Hashes the words and keeps them all for a word-by-word compare; used only when MaxSignatureWords fits, so
-// it needs no bound check per word.
-struct BufferedSink {
-  static constexpr std::size_t kCapacity = 512;  // 4 KiB of stack: infos of up to 102 geometries
-  uint64_t words[kCapacity];
-  std::size_t count = 0;
-  HashSink hash;
-  void operator()(uint64_t w) {
-    words[count++] = w;
-    hash(w);
-  }
-};
-
-struct CompareSink {
-  const std::vector<uint64_t>& words;
-  std::size_t next = 0;
-  bool equal = true;
-  void operator()(uint64_t w) {
-    equal = equal && next < words.size() && words[next] == w;
-    ++next;
-  }
-};
-
-struct StoreSink {
-  std::vector<uint64_t>& words;
-  void operator()(uint64_t w) { words.push_back(w); }
-};
-
-// fmix64: spread the last words into the high bits (which pick the shard) and the low ones (the slot of the
-// per-thread table).
-uint64_t Finish(uint64_t h) {
+  for (const uint64_t* w = s.data(), *end = s.data() + s.count(); w != end; ++w) h = (h ^ *w) * 0x9e3779b97f4a7c15ull;
   h ^= h >> 33;
   h *= 0xff51afd7ed558ccdull;
   h ^= h >> 33;
   return h;
-}
-
-uint64_t HashOf(const BuildSignature& s) {
-  HashSink sink;
-  EmitSignature(s, sink);
-  return Finish(sink.h);
 }
 
 // The per-thread table: direct-mapped, one signature per slot.
@@ -132,24 +119,7 @@ const VkAccelerationStructureGeometryKHR* BuildSignature::Geometry(uint32_t j) c
   return nullptr;
 }
 
-bool BuildSignature::Cacheable() const {
-  if (info->pNext) return false;
-  for (uint32_t j = 0; j < info->geometryCount; ++j) {
-    const VkAccelerationStructureGeometryKHR* g = Geometry(j);
-    if (!g || g->pNext) return false;
-    switch (g->geometryType) {
-      case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
-        if (g->geometry.triangles.pNext) return false;  // motion vertices, micromaps: sizes depend on them
-        break;
-      case VK_GEOMETRY_TYPE_AABBS_KHR:
-      case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-        break;
-      default:
-        return false;
-    }
-  }
-  return true;
-}
+bool BuildSignature::Cacheable() const { return SignatureWords(*this).count() != 0; }
 
 BuildSizeCache::BuildSizeCache() : id_(g_next_cache_id.fetch_add(1, std::memory_order_relaxed)) {}
 
@@ -165,16 +135,14 @@ void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::
 }
 
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) const {
-  if (MaxSignatureWords(signature) > BufferedSink::kCapacity) return FindLong(signature, out);
-  // The signature is read from the app's structures once: hashed and kept on the stack for the compares.
-  BufferedSink sink;
-  EmitSignature(signature, sink);
-  const uint64_t hash = Finish(sink.hash.h);
-  const bool local = sink.count <= kLocalWords;
+  const SignatureWords words(signature);
+  if (words.count() == 0) return false;  // never stored
+  const uint64_t hash = HashOf(words);
+  const bool local = words.count() <= kLocalWords;
   if (local) {
     const LocalEntry& slot = LocalSlot(hash);
-    if (slot.cache_id == id_ && slot.hash == hash && slot.count == sink.count &&
-        std::memcmp(slot.words, sink.words, sink.count * sizeof(uint64_t)) == 0) {
+    if (slot.cache_id == id_ && slot.hash == hash && slot.count == words.count() &&
+        std::memcmp(slot.words, words.data(), words.bytes()) == 0) {
       *out = slot.sizes;
       return true;
     }
@@ -185,26 +153,12 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) cons
     const auto it = shard.map.find(hash);
     if (it == shard.map.end()) return false;
     const std::vector<uint64_t>& stored = it->second.words;
-    if (stored.size() != sink.count || std::memcmp(stored.data(), sink.words, sink.count * sizeof(uint64_t)) != 0) {
+    if (stored.size() != words.count() || std::memcmp(stored.data(), words.data(), words.bytes()) != 0) {
       return false;
     }
     *out = it->second.sizes;
   }
-  if (local) RememberLocally(hash, sink.words, sink.count, *out);
-  return true;
-}
-
-bool BuildSizeCache::FindLong(const BuildSignature& signature, BuildSizes* out) const {
-  // Too long for the stack: hashed in one pass, compared against the stored copy in a second.
-  const uint64_t hash = HashOf(signature);
-  const Shard& shard = ShardFor(hash);
-  std::shared_lock lock(shard.mutex);
-  const auto it = shard.map.find(hash);
-  if (it == shard.map.end()) return false;
-  CompareSink compare{it->second.words};
-  EmitSignature(signature, compare);
-  if (!compare.equal || compare.next != it->second.words.size()) return false;
-  *out = it->second.sizes;
+  if (local) RememberLocally(hash, words.data(), words.count(), *out);
   return true;
 }
 
@@ -232,13 +186,13 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   query_(device_, signature.build_type, &info, counts, &answer);
   queries_.fetch_add(1, std::memory_order_relaxed);
   const BuildSizes sizes{answer.accelerationStructureSize, answer.buildScratchSize, answer.updateScratchSize};
-  if (!signature.Cacheable()) return sizes;
+  const SignatureWords words(signature);
+  if (words.count() == 0) return sizes;  // not cacheable
 
   Entry entry;
   entry.sizes = sizes;
-  StoreSink store{entry.words};
-  EmitSignature(signature, store);
-  const uint64_t hash = HashOf(signature);
+  entry.words.assign(words.data(), words.data() + words.count());
+  const uint64_t hash = HashOf(words);
   RememberLocally(hash, entry.words.data(), entry.words.size(), sizes);
   Shard& shard = ShardFor(hash);
   std::unique_lock lock(shard.mutex);

@@ -9,8 +9,10 @@
 // geometry's type, flags, formats, strides, maxVertex, index type, transform presence, instance layout and
 // primitive count), and nothing they do not (addresses, handles, mode: the driver ignores those).
 //
-// A hit reads the signature once (into a stack buffer), hashes it and compares a stored copy word by word (so a hash collision can never return
-// another build's sizes): no allocation, no driver call. Signatures of up to kLocalWords words (builds of up
+// A hit reads the signature once (into a stack buffer, or a per-thread one for infos of more than 102
+// geometries), hashes it and compares a stored copy word by word (so a hash collision can never return
+// another build's sizes): no allocation, no driver call. A build that is not Cacheable is never stored, and a
+// lookup gives up on it as soon as the signature shows it, without hashing. Signatures of up to kLocalWords words (builds of up
 // to two geometries) are first looked up in a small per-thread table, which needs no lock at all; the rest,
 // and per-thread misses, take one shard's shared lock. A miss of both asks the driver through the next
 // layer's dispatch and stores the answer.
@@ -106,8 +108,6 @@ class BuildSizeCache {
 
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
-  // Find for signatures too long to keep on the stack.
-  bool FindLong(const BuildSignature& signature, BuildSizes* out) const;
   // Stores a hit in the calling thread's table.
   void RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count, const BuildSizes& sizes) const;
 

@@ -4,6 +4,8 @@
 // shortcut (SameSignatureArrays) may only fire when the signature cannot differ.
 #include <catch2/catch_test_macros.hpp>
 
+#include <vector>
+
 #include "buffer_memo.h"
 #include "build_sizes.h"
 #include "state_tracker.h"
@@ -93,6 +95,38 @@ TEST_CASE("buffer memo: unchanged maps keep the entries from one command to the 
   // Any change to the buffer map is a new stamp.
   AddBoundBuffer(state, 3, kInput);
   CHECK(state.buffers.stamp() != before);
+}
+
+TEST_CASE("buffer memo: a command over 40 buffers keeps every one from one command to the next", "[memo]") {
+  // 16 infos, each with its own scratch and vertex buffer, plus their destinations' buffers: more buffers than
+  // the memo once held (32, replaced round-robin, so that every lookup of such a call missed). Each buffer must
+  // still be answered by the entry it got on the first command (the same address in the memo: no map lookup).
+  DeviceState state;
+  constexpr uintptr_t kBuffers = 40;
+  for (uintptr_t n = 1; n <= kBuffers; ++n) AddBoundBuffer(state, n, kInput);
+  BufferMemo memo;
+  std::vector<const KnownBuffer*> first;
+  for (int command = 0; command < 2; ++command) {
+    memo.Sync(state);
+    for (uintptr_t n = 1; n <= kBuffers; ++n) {
+      const KnownBuffer* held =
+          memo.Held(state, n * 0x10000 + 16, 64, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+      REQUIRE(held);
+      CHECK(held->buffer == Fake<VkBuffer>(n));
+      if (command == 0) {
+        first.push_back(held);
+      } else {
+        CHECK(held == first[n - 1]);
+      }
+    }
+  }
+  // Found by handle, the answers agree with the shadow state.
+  for (uintptr_t n = 1; n <= kBuffers; ++n) {
+    KnownBuffer found;
+    REQUIRE(memo.Find(state, Fake<VkBuffer>(n), &found));
+    CHECK(found.base == n * 0x10000);
+    CHECK(found.memory == Fake<VkDeviceMemory>(100));
+  }
 }
 
 }  // namespace

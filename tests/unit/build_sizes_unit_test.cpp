@@ -38,6 +38,25 @@ TEST_CASE("size cache: a steady stream of the same build asks the driver once", 
   CHECK(FakeSizes::queries == 1);
 }
 
+TEST_CASE("size cache: a build of 256 geometries is found, and a change in its last count is seen", "[sizes][cache]") {
+  // Longer than the lookup's stack buffer (102 geometries): read into the per-thread buffer, in one pass.
+  BuildStateFixture f;
+  const std::vector<VkAccelerationStructureGeometryKHR> geometries(256, TriangleGeometry(0x1000));
+  VkAccelerationStructureBuildGeometryInfoKHR info = OneGeometryInfo(kBottom, geometries.data());
+  info.geometryCount = 256;
+  std::vector<uint32_t> counts(256, 1);
+  BuildSizes sizes;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  REQUIRE(f.state.build_sizes.Query(Signature(info, counts)));
+  REQUIRE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  CHECK(sizes.acceleration_structure_size == FakeSizes::Structure(256));
+  counts.back() = 2;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  counts.back() = 1;
+  CHECK(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  CHECK(f.state.build_sizes.queries() == 1);
+}
+
 TEST_CASE("size cache: counts, formats, flags and geometry counts are part of the signature", "[sizes][cache]") {
   BuildStateFixture f;
   VkAccelerationStructureGeometryKHR g = TriangleGeometry(0x1000);

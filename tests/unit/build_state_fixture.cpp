@@ -1,7 +1,6 @@
 #include "build_state_fixture.h"
 
-#include "build_host.h"
-#include "build_memory_pass.h"
+#include "build_validation.h"
 #include "state_tracker.h"
 #include "vk_dispatch_table.h"
 
@@ -130,9 +129,7 @@ void BuildStateFixture::DestroyStructure(VkAccelerationStructureKHR as) { Record
 
 bool BuildStateFixture::Validate(const BuildCommand& cmd) {
   const CheckContext ctx{state, reporter, kCheckAddresses | kCheckAliasing | kCheckHost};
-  bool skip = ValidateBuildMemory(ctx, cmd);
-  skip |= ValidateBuildHost(ctx, cmd);
-  return skip;
+  return ValidateBuildCommand(ctx, cmd);  // the three families only: the context enables no other
 }
 
 std::vector<std::string> BuildStateFixture::Take() {

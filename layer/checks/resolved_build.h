@@ -1,0 +1,73 @@
+#pragma once
+// One build command as every rule family sees it, resolved once per call: for each info, the records of its
+// destination and source structures, the buffer under the destination, the driver's sizes for this build and
+// the buffer that holds its scratch. Before this view each family looked these up on its own (the destination
+// twice per info, the sizes and scratch once per family). Computed by ResolveBuild (checks code, const over the
+// shadow state); a family reads it and never changes it.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "buffer_memo.h"
+#include "build_command.h"
+#include "build_size_cache.h"
+#include "check_context.h"
+#include "objects.h"
+
+namespace asval {
+
+struct ResolvedInfo {
+  // dstAccelerationStructure's record; null when the handle is not a live structure of this device.
+  std::shared_ptr<const AccelerationStructureState> dst;
+  // srcAccelerationStructure's record; null when the handle is VK_NULL_HANDLE or not a live structure.
+  std::shared_ptr<const AccelerationStructureState> src;
+  // The rest is resolved only when the addresses or aliasing family is on (placed = true).
+  bool placed = false;
+  // The destination's buffer (dst_buffer_known: the layer knows it).
+  KnownBuffer dst_buffer;
+  bool dst_buffer_known = false;
+  std::optional<BuildSizes> sizes;  // nullopt: unknown (the family that needs them counts it)
+  // Bytes of scratch this build needs (build or update size), and, for device builds, the buffer holding
+  // them all with STORAGE_BUFFER usage when there is one.
+  VkDeviceSize scratch_bytes = 0;
+  bool scratch_in_storage = false;
+  KnownBuffer scratch_buffer;
+};
+
+struct ResolvedWorkspace;
+
+// The view of one call. Lives on the hook's stack for the duration of the validation; its per-info records
+// live there too for small calls, else in a per-thread buffer that keeps its capacity, so a steady stream of
+// calls allocates nothing.
+class ResolvedBuild {
+ public:
+  ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd);
+  ~ResolvedBuild();
+  ResolvedBuild(const ResolvedBuild&) = delete;
+  ResolvedBuild& operator=(const ResolvedBuild&) = delete;
+
+  // pInfos[i] resolved (i < cmd.info_count; empty records when cmd.infos is null).
+  const ResolvedInfo& info(uint32_t i) const { return infos_[i]; }
+  // This thread's buffer memo, synced for this call: the families' further lookups (geometry inputs, the
+  // source's buffer) go through it. Only when placement was resolved (addresses or aliasing on).
+  BufferMemo& memo() const { return *memo_; }
+
+ private:
+  // Calls of up to this many infos keep their records on the stack (no per-thread lookup, no vector).
+  static constexpr uint32_t kInlineInfos = 2;
+  union Inline {
+    Inline() {}
+    ~Inline() {}
+    ResolvedInfo infos[kInlineInfos];
+  } inline_;
+  uint32_t inline_count_ = 0;  // records constructed in inline_
+  ResolvedWorkspace* w_ = nullptr;
+  std::unique_ptr<ResolvedWorkspace> owned_;  // only when the thread's workspace is already in use
+  ResolvedInfo* infos_ = nullptr;
+  BufferMemo* memo_ = nullptr;
+};
+
+}  // namespace asval
