@@ -45,7 +45,8 @@ namespace vertex_format_table {
 // decodable one) are indexed by their value: the checks look a format up once per triangle geometry of every
 // recorded build, so that lookup is one bounds test and one load.
 inline constexpr uint32_t kIndexedCount = VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 + 1;
-extern const std::array<VertexFormatInfo, kIndexedCount> kIndexed;
+// Hidden: the layer is one shared object, so the checks reach the table PC-relative, not through the GOT.
+extern const std::array<VertexFormatInfo, kIndexedCount> kIndexed __attribute__((visibility("hidden")));
 
 // Every other value: a short search, out of line (rare formats; an all-zero row for those not described).
 const VertexFormatInfo& OtherFormat(VkFormat format);
