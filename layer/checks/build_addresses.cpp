@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 
+#include "asval/vertex_formats.h"
 #include "buffer_lookup.h"
 #include "buffer_memo.h"
 #include "build_report.h"
@@ -20,34 +21,12 @@ constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);            // 24
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64 (motion instances: more)
 
 // Bytes of one vertex of `format` (never more than the real size: a range the layer computes must be a lower
-// bound of what the build reads). Formats outside the table count as their alignment unit, at least 1.
-// The formats with a known size all have core enum values below 110: a table, not a switch, on the hot path.
-constexpr std::size_t kVertexBytesTableSize = 110;
-constexpr std::array<uint8_t, kVertexBytesTableSize> MakeVertexBytesTable() {
-  std::array<uint8_t, kVertexBytesTableSize> t{};
-  t[VK_FORMAT_R32G32B32A32_SFLOAT] = 16;
-  t[VK_FORMAT_R32G32B32_SFLOAT] = 12;
-  t[VK_FORMAT_R32G32_SFLOAT] = 8;
-  t[VK_FORMAT_R16G16B16A16_SFLOAT] = 8;
-  t[VK_FORMAT_R16G16B16A16_SNORM] = 8;
-  t[VK_FORMAT_R16G16B16A16_UNORM] = 8;
-  t[VK_FORMAT_R16G16_SFLOAT] = 4;
-  t[VK_FORMAT_R16G16_SNORM] = 4;
-  t[VK_FORMAT_R16G16_UNORM] = 4;
-  t[VK_FORMAT_R8G8B8A8_SNORM] = 4;
-  t[VK_FORMAT_R8G8B8A8_UNORM] = 4;
-  t[VK_FORMAT_A2B10G10R10_UNORM_PACK32] = 4;
-  t[VK_FORMAT_R8G8_SNORM] = 2;
-  t[VK_FORMAT_R8G8_UNORM] = 2;
-  return t;
-}
-constexpr std::array<uint8_t, kVertexBytesTableSize> kVertexBytes = MakeVertexBytesTable();
-
+// bound of what the build reads): the texel size for the acceleration-structure vertex formats the shared
+// table decodes, else the format's alignment unit, at least 1. One table index on the hot path.
 VkDeviceSize VertexBytes(VkFormat format) {
-  const auto index = static_cast<uint32_t>(format);
-  if (index < kVertexBytesTableSize && kVertexBytes[index] != 0) return kVertexBytes[index];
-  const uint32_t unit = AlignmentOfVertexFormat(format).bytes;
-  return unit ? unit : 1;
+  const VertexFormatInfo& facts = VertexFormatFacts(format);
+  if (facts.decodable) return facts.vertexBytes;
+  return facts.componentBytes ? facts.componentBytes : 1;
 }
 
 // One range a geometry reads, and the rule that makes its start a valid device address. No default member

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 
+#include "asval/vertex_formats.h"
 #include "build_report.h"
 #include "vk_enum_string.h"
 
@@ -22,29 +23,12 @@ constexpr VkGeometryFlagsKHR kCoreGeometryFlags =
     VK_GEOMETRY_OPAQUE_BIT_KHR | VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR;
 constexpr VkDeviceSize kMaxStride = 0xffffffffull;
 
-// Component size of the vertex formats the query accepts; 0 for others. The device's format features
+// Alignment unit (component size, or size of a packed format) of the acceleration-structure vertex formats
+// the shared table decodes, the formats the query accepts; 0 for others. The device's format features
 // decide whether the format is usable at all.
 uint32_t VertexComponentBytes(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R32G32_SFLOAT:
-    case VK_FORMAT_R32G32B32_SFLOAT:
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-      return 4;
-    case VK_FORMAT_R16G16_SFLOAT:
-    case VK_FORMAT_R16G16B16A16_SFLOAT:
-    case VK_FORMAT_R16G16_SNORM:
-    case VK_FORMAT_R16G16B16A16_SNORM:
-    case VK_FORMAT_R16G16_UNORM:
-    case VK_FORMAT_R16G16B16A16_UNORM:
-      return 2;
-    case VK_FORMAT_R8G8_SNORM:
-    case VK_FORMAT_R8G8B8A8_SNORM:
-    case VK_FORMAT_R8G8_UNORM:
-    case VK_FORMAT_R8G8B8A8_UNORM:
-      return 1;
-    default:
-      return 0;
-  }
+  const VertexFormatInfo& facts = VertexFormatFacts(format);
+  return facts.decodable ? facts.componentBytes : 0;
 }
 
 bool TrianglesQueryable(const DeviceState& state, const VkAccelerationStructureGeometryTrianglesDataKHR& t) {
