@@ -288,7 +288,7 @@ TEST_CASE("history valid twin: deserializing device bytes overwritten by vkCmdCo
   device.Destroy(of_two.bytes);
 }
 
-TEST_CASE("history valid twin: updating a structure deserialized from bytes the layer saw serialized stays silent",
+TEST_CASE("history valid twin: updating a structure deserialized from device bytes stays silent (history unknown)",
           "[integration][history]") {
   HistoryFixture f;
   vkkit::Device& device = f.device();
