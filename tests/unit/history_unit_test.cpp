@@ -300,6 +300,8 @@ TEST_CASE("history unit: a build over another structure's memory clobbers it; a 
         std::vector<std::string>{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03667"});
 }
 
+// Another submission can no longer come in between (submission_order: see "a submission on another queue waits
+// ..." below), but a host build that completes on another thread while a submission's downcall runs can.
 TEST_CASE("history unit: undo restores what a skipped submission changed, but not later changes", "[history]") {
   World w;
   HistoryStore& store = w.state.history.store;
@@ -319,7 +321,7 @@ TEST_CASE("history unit: undo restores what a skipped submission changed, but no
   {
     auto lock = store.Lock();
     ApplyOp(w.state, store, batch, batch.ops()[0], &txn);    // ours: 2 geometries
-    ApplyOp(w.state, store, later, later.ops()[0], nullptr);  // another thread's submission after ours: 3
+    ApplyOp(w.state, store, later, later.ops()[0], nullptr);  // a host build completing meanwhile: 3
     store.Undo(txn);
     CHECK(store.Get(w.a).build->geometries.size() == 3);  // the newer change stays
   }
