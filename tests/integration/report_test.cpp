@@ -7,6 +7,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "temp_report.h"
 #include "fixture.h"
 
 namespace asval_test {
@@ -83,39 +84,8 @@ TEST_CASE("message_id_filter mutes by suffix, by full name and by id", "[integra
   }
 }
 
-// A report file in /tmp, removed at the end; Lines() reads what the layer wrote.
-struct TempReport {
-  std::string path;
-  TempReport() {
-    char name[] = "/tmp/asval-report-XXXXXX";
-    const int fd = mkstemp(name);
-    REQUIRE(fd >= 0);
-    close(fd);
-    path = name;
-  }
-  ~TempReport() { std::remove(path.c_str()); }
-  std::vector<std::string> Lines() const {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<std::string> lines;
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  }
-};
-
-// The line with bytes outside printable ASCII as \xNN: Catch2's message printer asserts on some raw bytes.
-std::string Printable(const std::string& line) {
-  std::string out;
-  for (unsigned char c : line) {
-    if (c >= 0x20 && c < 0x7f) {
-      out.push_back(static_cast<char>(c));
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof(hex), "\\x%02x", c);
-      out.append(hex);
-    }
-  }
-  return out;
-}
+using asval_test_common::Printable;
+using asval_test_common::TempReport;
 
 // One misaligned build with the structure named blas_name, reported into a report file; its lines.
 std::vector<std::string> ReportMisalignedBuild(const char* blas_name) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "temp_report.h"
 #include "location.h"
 #include "message_id.h"
 #include "reporter.h"
@@ -125,39 +126,8 @@ TEST_CASE("info messages are counted as info, not as warnings", "[report]") {
   CHECK(reporter.ErrorCount() == 0);
 }
 
-// A report file in /tmp, removed at the end; Lines() reads what the reporter wrote.
-struct TempReport {
-  std::string path;
-  TempReport() {
-    char name[] = "/tmp/asval-report-unit-XXXXXX";
-    const int fd = mkstemp(name);
-    REQUIRE(fd >= 0);
-    close(fd);
-    path = name;
-  }
-  ~TempReport() { std::remove(path.c_str()); }
-  std::vector<std::string> Lines() const {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<std::string> lines;
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  }
-};
-
-// The line with bytes outside printable ASCII as \xNN: Catch2's message printer asserts on some raw bytes.
-std::string Printable(const std::string& line) {
-  std::string out;
-  for (unsigned char c : line) {
-    if (c >= 0x20 && c < 0x7f) {
-      out.push_back(static_cast<char>(c));
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof(hex), "\\x%02x", c);
-      out.append(hex);
-    }
-  }
-  return out;
-}
+using asval_test_common::Printable;
+using asval_test_common::TempReport;
 
 // U+FFFD REPLACEMENT CHARACTER in UTF-8: what each invalid byte of a name becomes in the report.
 constexpr const char* kReplacement = "\xEF\xBF\xBD";
