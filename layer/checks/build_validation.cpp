@@ -31,9 +31,9 @@ bool Unresolved(const CheckContext& ctx, const BuildCommand& cmd, const Resolved
 constexpr BuildFamily kBuildFamilies[] = {
     {kCheckFeatures, &Unresolved<&ValidateBuildFeatures>},
     {kCheckHandles, &ValidateBuildHandles},
-    {kCheckStructure, &Unresolved<&ValidateBuildStructure>},
-    {kCheckStructure, &Unresolved<&ValidateBuildRanges>},
-    {kCheckAlignment, &Unresolved<&ValidateBuildAlignment>},
+    {kCheckStructure, &ValidateBuildStructure},
+    {kCheckStructure, &ValidateBuildRanges},
+    {kCheckAlignment, &ValidateBuildAlignment},
     {kCheckHistory, &Unresolved<&ValidateBuildHistory>},  // host builds only; device builds: at submission
     // Addresses and aliasing share one pass over the resolved sizes, destinations and scratch.
     {kCheckAddressesOrAliasing, &ValidateBuildMemory},

@@ -3,6 +3,7 @@
 #include <new>
 
 #include "build_size_lookup.h"
+#include "geometry_pass.h"
 
 namespace asval {
 
@@ -79,7 +80,9 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.infos) return;
   const bool records = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckHandles | kCheckAddresses | kCheckAliasing));
   const bool placement = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckAddresses | kCheckAliasing));
-  if (!records) return;
+  // The families with per-geometry rules; host builds are not screened (geometry_pass.h).
+  const bool screening =
+      !cmd.is_host() && ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckStructure | kCheckAlignment | kCheckAddresses));
   if (placement) {
     // Kept from call to call on this thread; Sync empties it when the buffers or their addresses changed.
     memo_ = &ThisThreadsMemo();
@@ -88,9 +91,12 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd) {
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
     ResolvedInfo& r = infos_[i];
-    r.dst = FindStructure(ctx.state, info.dstAccelerationStructure);
-    r.src = FindStructure(ctx.state, info.srcAccelerationStructure);
-    if (placement) Place(ctx, cmd, i, *memo_, i > 0 ? infos_[i - 1].sizes : std::nullopt, r);
+    if (records) {
+      r.dst = FindStructure(ctx.state, info.dstAccelerationStructure);
+      r.src = FindStructure(ctx.state, info.srcAccelerationStructure);
+      if (placement) Place(ctx, cmd, i, *memo_, i > 0 ? infos_[i - 1].sizes : std::nullopt, r);
+    }
+    if (screening) ScreenGeometries(ctx, cmd, i, memo_, r);
   }
 }
 

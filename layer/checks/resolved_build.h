@@ -19,7 +19,23 @@
 
 namespace asval {
 
+// The per-geometry walks of the families (ResolvedInfo::walks): the structure family's geometry rules
+// (build_structure.h), its range rules (build_ranges.h), the alignment family's input rules
+// (build_input_alignment.h), the addresses family's input reads (build_input_reads.h) and instance counts
+// (build_sizes.h).
+enum GeometryWalk : uint8_t {
+  kWalkStructure = 1u << 0,
+  kWalkRanges = 1u << 1,
+  kWalkInputAlignment = 1u << 2,
+  kWalkInputReads = 1u << 3,
+  kWalkInstanceCounts = 1u << 4,
+  kWalkAll = (1u << 5) - 1,
+};
+
 struct ResolvedInfo {
+  // The families that must walk this info's geometries themselves: the geometry pass (geometry_pass.h) found
+  // something to report or count for them, or did not screen this info. The others' rules found nothing.
+  uint8_t walks = kWalkAll;
   // dstAccelerationStructure's record; null when the handle is not a live structure of this device.
   std::shared_ptr<const AccelerationStructureState> dst;
   // srcAccelerationStructure's record; null when the handle is VK_NULL_HANDLE or not a live structure.
