@@ -5,39 +5,12 @@
 
 #include "buffer_lookup.h"
 #include "buffer_memo.h"
+#include "check_thread_data.h"
 #include "build_report.h"
 #include "build_sizes.h"
 #include "host_instances.h"
 
 namespace asval {
-
-namespace {
-
-// What a span of memory is to its info. The order matters only for naming pairs (lower kind first).
-enum class SpanKind : uint8_t { kDst, kSrc, kScratch, kReferenced };
-
-// Bytes one info accesses: [begin, end) of a VkDeviceMemory (space = its handle), or of the host's address
-// space (host builds' scratch; space = kHostSpace: no VkDeviceMemory handle is 0).
-constexpr uint64_t kHostSpace = 0;
-struct AccessSpan {
-  uint64_t space;
-  VkDeviceSize begin;
-  VkDeviceSize end;
-  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
-  uint32_t info;
-  SpanKind kind;
-};
-
-}  // namespace
-
-// Per-thread buffers, reused from call to call so that a steady stream of builds allocates nothing.
-struct AliasingWorkspace {
-  bool in_use = false;
-  std::vector<AccessSpan> spans;
-  std::vector<uint32_t> active;
-  std::vector<uint64_t> references;
-  std::vector<std::pair<uint64_t, uint32_t>> destinations;  // (handle, info), sorted
-};
 
 namespace {
 
@@ -174,7 +147,7 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
     CountUnknownState(ctx);
   }
   if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR && info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    if (StructureSpan(ctx.state, memo, r.src.get(), r.sizes->acceleration_structure_size, i, SpanKind::kSrc,
+    if (StructureSpan(ctx.state, memo, r.src, r.sizes->acceleration_structure_size, i, SpanKind::kSrc,
                       &span)) {
       w.spans.push_back(span);
     } else {
@@ -278,7 +251,7 @@ bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, ui
   AccessSpan src, dst;
   const VkDeviceSize whole = ~VkDeviceSize{0};
   if (!r.dst || !r.dst_buffer_known || !StructureSpan(*r.dst, r.dst_buffer, whole, i, SpanKind::kDst, &dst) ||
-      !StructureSpan(ctx.state, memo, r.src.get(), whole, i, SpanKind::kSrc, &src)) {
+      !StructureSpan(ctx.state, memo, r.src, whole, i, SpanKind::kSrc, &src)) {
     CountUnknownState(ctx);
     return false;
   }
@@ -328,29 +301,10 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
 
 }  // namespace
 
-namespace {
-
-// This thread's workspace, or null while a sweep on this thread already holds it (an app callback that
-// records a build from inside a report): the nested sweep then works in a buffer of its own.
-AliasingWorkspace* TakeThreadWorkspace() {
-  thread_local AliasingWorkspace workspace;
-  if (workspace.in_use) return nullptr;
-  workspace.in_use = true;
-  return &workspace;
-}
-
-}  // namespace
-
-AliasingSweep::AliasingSweep() : w_(TakeThreadWorkspace()) {
-  if (!w_) {
-    owned_ = std::make_unique<AliasingWorkspace>();
-    w_ = owned_.get();
-  }
+AliasingSweep::AliasingSweep(CheckThreadData& thread) {
+  if (!thread.aliasing) thread.aliasing = std::make_unique<AliasingWorkspace>();
+  w_ = thread.aliasing.get();
   w_->spans.clear();
-}
-
-AliasingSweep::~AliasingSweep() {
-  if (!owned_) w_->in_use = false;
 }
 
 bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,

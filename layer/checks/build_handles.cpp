@@ -57,7 +57,7 @@ bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
 bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
-  const AccelerationStructureState* dst = r.dst.get();
+  const AccelerationStructureState* dst = r.dst;
   if (!dst) {
     skip |= ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
                         [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
@@ -70,7 +70,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
     if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
   }
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    const AccelerationStructureState* src = r.src.get();
+    const AccelerationStructureState* src = r.src;
     if (!src) {
       skip |= ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
                           [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },

@@ -171,11 +171,13 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
   return primitives <= limits.maxPrimitiveCount;
 }
 
-std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i) {
+std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i,
+                                      BuildSizeCache::ThreadTable* table) {
   BuildSignature signature;
   BuildSizes sizes;
   if (SignatureOfInfo(cmd, i, &signature)) {
-    if (state.build_sizes.Find(signature, &sizes)) return sizes;
+    const bool found = table ? state.build_sizes.Find(signature, &sizes, *table) : state.build_sizes.Find(signature, &sizes);
+    if (found) return sizes;
     if (SizeQueryIsValid(state, signature)) {
       if (std::optional<BuildSizes> queried = state.build_sizes.Query(signature)) return queried;
     }

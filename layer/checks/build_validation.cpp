@@ -7,6 +7,7 @@
 #include "build_memory_pass.h"
 #include "build_ranges.h"
 #include "build_structure.h"
+#include "check_thread_data.h"
 #include "history_host.h"
 #include "resolved_build.h"
 
@@ -43,7 +44,8 @@ constexpr BuildFamily kBuildFamilies[] = {
 }  // namespace
 
 bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
-  const ResolvedBuild resolved(ctx, cmd);
+  const CheckThreadLease thread;  // the one thread_local access of the call
+  const ResolvedBuild resolved(ctx, cmd, thread.data());
   bool skip = false;
   for (const BuildFamily& f : kBuildFamilies) {
     if (ctx.Enabled(f.family)) skip |= f.validate(ctx, cmd, resolved);

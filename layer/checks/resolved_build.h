@@ -37,9 +37,12 @@ struct ResolvedInfo {
   // something to report or count for them, or did not screen this info. The others' rules found nothing.
   uint8_t walks = kWalkAll;
   // dstAccelerationStructure's record; null when the handle is not a live structure of this device.
-  std::shared_ptr<const AccelerationStructureState> dst;
+  const AccelerationStructureState* dst = nullptr;
   // srcAccelerationStructure's record; null when the handle is VK_NULL_HANDLE or not a live structure.
-  std::shared_ptr<const AccelerationStructureState> src;
+  const AccelerationStructureState* src = nullptr;
+  // Both stay valid for the call: the thread's structure memo holds them, or, when it could not, these do.
+  std::shared_ptr<const AccelerationStructureState> dst_held;
+  std::shared_ptr<const AccelerationStructureState> src_held;
   // The rest is resolved only when the addresses or aliasing family is on (placed = true).
   bool placed = false;
   // The destination's buffer (dst_buffer_known: the layer knows it).
@@ -53,14 +56,15 @@ struct ResolvedInfo {
   KnownBuffer scratch_buffer;
 };
 
-struct ResolvedWorkspace;
+struct CheckThreadData;
 
 // The view of one call. Lives on the hook's stack for the duration of the validation; its per-info records
-// live there too for small calls, else in a per-thread buffer that keeps its capacity, so a steady stream of
-// calls allocates nothing.
+// live there too for small calls, else in the thread's data (check_thread_data.h), which keeps its capacity,
+// so a steady stream of calls allocates nothing.
 class ResolvedBuild {
  public:
-  ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd);
+  // thread: this call's lease of the thread's data (memos, buffers), held for the whole validation.
+  ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, CheckThreadData& thread);
   ~ResolvedBuild();
   ResolvedBuild(const ResolvedBuild&) = delete;
   ResolvedBuild& operator=(const ResolvedBuild&) = delete;
@@ -70,6 +74,8 @@ class ResolvedBuild {
   // This thread's buffer memo, synced for this call: the families' further lookups (geometry inputs, the
   // source's buffer) go through it. Only when placement was resolved (addresses or aliasing on).
   BufferMemo& memo() const { return *memo_; }
+  // This call's lease of the thread's data (the aliasing sweep's buffers).
+  CheckThreadData& thread() const { return thread_; }
 
  private:
   // Calls of up to this many infos keep their records on the stack (no per-thread lookup, no vector).
@@ -80,8 +86,7 @@ class ResolvedBuild {
     ResolvedInfo infos[kInlineInfos];
   } inline_;
   uint32_t inline_count_ = 0;  // records constructed in inline_
-  ResolvedWorkspace* w_ = nullptr;
-  std::unique_ptr<ResolvedWorkspace> owned_;  // only when the thread's workspace is already in use
+  CheckThreadData& thread_;
   ResolvedInfo* infos_ = nullptr;
   BufferMemo* memo_ = nullptr;
 };

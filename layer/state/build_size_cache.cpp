@@ -94,19 +94,10 @@ uint64_t HashOf(const SignatureWords& s) {
   return h;
 }
 
-// The per-thread table: direct-mapped, one signature per slot.
-struct LocalEntry {
-  uint64_t cache_id = 0;  // 0: empty (cache ids start at 1)
-  uint64_t hash = 0;
-  std::size_t count = 0;
-  uint64_t words[BuildSizeCache::kLocalWords];
-  BuildSizes sizes;
-};
-constexpr std::size_t kLocalSlots = 64;
-
-LocalEntry& LocalSlot(uint64_t hash) {
-  thread_local LocalEntry table[kLocalSlots];
-  return table[hash & (kLocalSlots - 1)];
+// The table of callers that keep none of their own (the host family, tests).
+BuildSizeCache::ThreadTable& ThisThreadsTable() {
+  thread_local BuildSizeCache::ThreadTable table;
+  return table;
 }
 
 std::atomic<uint64_t> g_next_cache_id{1};
@@ -123,10 +114,10 @@ bool BuildSignature::Cacheable() const { return SignatureWords(*this).count() !=
 
 BuildSizeCache::BuildSizeCache() : id_(g_next_cache_id.fetch_add(1, std::memory_order_relaxed)) {}
 
-void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count,
+void BuildSizeCache::RememberLocally(ThreadTable& table, uint64_t hash, const uint64_t* words, std::size_t count,
                                      const BuildSizes& sizes) const {
   if (count > kLocalWords) return;
-  LocalEntry& slot = LocalSlot(hash);
+  ThreadTable::Entry& slot = table.SlotFor(hash);
   slot.cache_id = id_;
   slot.hash = hash;
   slot.count = count;
@@ -135,12 +126,16 @@ void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::
 }
 
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) const {
+  return Find(signature, out, ThisThreadsTable());
+}
+
+bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const {
   const SignatureWords words(signature);
   if (words.count() == 0) return false;  // never stored
   const uint64_t hash = HashOf(words);
   const bool local = words.count() <= kLocalWords;
   if (local) {
-    const LocalEntry& slot = LocalSlot(hash);
+    const ThreadTable::Entry& slot = table.SlotFor(hash);
     if (slot.cache_id == id_ && slot.hash == hash && slot.count == words.count() &&
         std::memcmp(slot.words, words.data(), words.bytes()) == 0) {
       *out = slot.sizes;
@@ -158,7 +153,7 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) cons
     }
     *out = it->second.sizes;
   }
-  if (local) RememberLocally(hash, words.data(), words.count(), *out);
+  if (local) RememberLocally(table, hash, words.data(), words.count(), *out);
   return true;
 }
 
@@ -193,7 +188,7 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   entry.sizes = sizes;
   entry.words.assign(words.data(), words.data() + words.count());
   const uint64_t hash = HashOf(words);
-  RememberLocally(hash, entry.words.data(), entry.words.size(), sizes);
+  RememberLocally(ThisThreadsTable(), hash, entry.words.data(), entry.words.size(), sizes);
   Shard& shard = ShardFor(hash);
   std::unique_lock lock(shard.mutex);
   if (shard.map.size() >= kMaxEntriesPerShard) shard.map.clear();

@@ -73,8 +73,27 @@ class BuildSizeCache {
   }
   bool can_query() const { return query_ != nullptr; }
 
+  // Signatures of at most this many words also live in the per-thread table.
+  static constexpr std::size_t kLocalWords = 16;
+
+  // A thread's table of recent hits: direct-mapped, one signature per slot, no lock. A caller that keeps one per
+  // thread (the checks' per-thread data) passes it in; the overload without one uses a thread_local table.
+  struct ThreadTable {
+    struct Entry {
+      uint64_t cache_id = 0;  // 0: empty (cache ids start at 1)
+      uint64_t hash = 0;
+      std::size_t count = 0;
+      uint64_t words[kLocalWords];
+      BuildSizes sizes;
+    };
+    static constexpr std::size_t kSlots = 64;
+    Entry entries[kSlots];
+    Entry& SlotFor(uint64_t hash) { return entries[hash & (kSlots - 1)]; }
+  };
+
   // The cached sizes of this build, if it was queried before.
   bool Find(const BuildSignature& signature, BuildSizes* out) const;
+  bool Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const;
 
   // Asks the driver and caches the answer (unless !signature.Cacheable()). The caller must have made sure
   // that the query is valid for this info (the layer's own calls must be valid): features enabled, a
@@ -87,9 +106,6 @@ class BuildSizeCache {
   std::size_t size() const;
   // Forgets every answer (the per-thread tables too). Not concurrent with Find/Query.
   void Clear();
-
-  // Signatures of at most this many words also live in the per-thread table.
-  static constexpr std::size_t kLocalWords = 16;
 
   // A shard holds at most this many signatures; a full shard is emptied (apps whose counts change every
   // frame would otherwise grow the cache without bound).
@@ -109,7 +125,8 @@ class BuildSizeCache {
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
   // Stores a hit in the calling thread's table.
-  void RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count, const BuildSizes& sizes) const;
+  void RememberLocally(ThreadTable& table, uint64_t hash, const uint64_t* words, std::size_t count,
+                       const BuildSizes& sizes) const;
 
   // Names this cache's entries in the per-thread tables; never reused, so an entry of a destroyed device's
   // cache can never answer for another device.
