@@ -83,9 +83,10 @@ bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, co
   if (!cmd.infos || cmd.is_host()) return false;
   ReportingJudge judge{ctx};
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+  // Infos in which the command's geometry pass found nothing for these rules are not walked again.
+  const uint32_t walked = resolved.walks() & kWalkInputAlignment ? cmd.info_count : 0;
+  for (uint32_t i = 0; i < walked; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-    // Infos in which the command's geometry pass found nothing for these rules are not walked again.
     if (!(resolved.info(i).walks & kWalkInputAlignment) || !GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
       const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);

@@ -116,7 +116,7 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
 }
 
 bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
-  if (!cmd.infos || !cmd.ranges) return false;
+  if (!cmd.infos || !cmd.ranges || !(resolved.walks() & kWalkRanges)) return false;
   ReportingJudge judge{ctx};
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {

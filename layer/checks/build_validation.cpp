@@ -21,6 +21,7 @@ namespace {
 struct BuildFamily {
   LayerSettingFlagBits family;
   bool (*validate)(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved);
+  bool host_only = false;  // has nothing to say about device builds (not called for them)
 };
 
 // For the families that need nothing resolved.
@@ -35,10 +36,10 @@ constexpr BuildFamily kBuildFamilies[] = {
     {kCheckStructure, &ValidateBuildStructure},
     {kCheckStructure, &ValidateBuildRanges},
     {kCheckAlignment, &ValidateBuildAlignment},
-    {kCheckHistory, &Unresolved<&ValidateBuildHistory>},  // host builds only; device builds: at submission
+    {kCheckHistory, &Unresolved<&ValidateBuildHistory>, true},  // device builds: at submission
     // Addresses and aliasing share one pass over the resolved sizes, destinations and scratch.
     {kCheckAddressesOrAliasing, &ValidateBuildMemory},
-    {kCheckHost, &ValidateBuildHost},
+    {kCheckHost, &ValidateBuildHost, true},
 };
 
 }  // namespace
@@ -48,7 +49,7 @@ bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
   const ResolvedBuild resolved(ctx, cmd, thread.data());
   bool skip = false;
   for (const BuildFamily& f : kBuildFamilies) {
-    if (ctx.Enabled(f.family)) skip |= f.validate(ctx, cmd, resolved);
+    if (ctx.Enabled(f.family) && (!f.host_only || cmd.is_host())) skip |= f.validate(ctx, cmd, resolved);
   }
   return skip;
 }

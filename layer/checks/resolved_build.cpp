@@ -46,6 +46,7 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, C
     infos_ = thread.infos.data();
   }
   if (!cmd.infos) return;
+  walks_ = 0;
   const bool records = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckHandles | kCheckAddresses | kCheckAliasing));
   const bool placement = ctx.Enabled(static_cast<LayerSettingFlagBits>(kCheckAddresses | kCheckAliasing));
   // The families with per-geometry rules; host builds are not screened (geometry_pass.h).
@@ -75,6 +76,7 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, C
         ScreenGeometries(ctx, cmd, i, memo_, r);
       }
     }
+    walks_ |= r.walks;
   }
 }
 

@@ -71,6 +71,8 @@ class ResolvedBuild {
 
   // pInfos[i] resolved (i < cmd.info_count; empty records when cmd.infos is null).
   const ResolvedInfo& info(uint32_t i) const { return infos_[i]; }
+  // The union of the infos' walks: a family whose bit is clear walks no info's geometries at all.
+  uint8_t walks() const { return walks_; }
   // This thread's buffer memo, synced for this call: the families' further lookups (geometry inputs, the
   // source's buffer) go through it. Only when placement was resolved (addresses or aliasing on).
   BufferMemo& memo() const { return *memo_; }
@@ -86,6 +88,7 @@ class ResolvedBuild {
     ResolvedInfo infos[kInlineInfos];
   } inline_;
   uint32_t inline_count_ = 0;  // records constructed in inline_
+  uint8_t walks_ = kWalkAll;
   CheckThreadData& thread_;
   ResolvedInfo* infos_ = nullptr;
   BufferMemo* memo_ = nullptr;

@@ -11,7 +11,9 @@
 //
 // A hit reads the signature once (into a stack buffer, or a per-thread one for infos of more than 102
 // geometries), hashes it and compares a stored copy word by word (so a hash collision can never return
-// another build's sizes): no allocation, no driver call. A build that is not Cacheable is never stored, and a
+// another build's sizes): no allocation, no driver call. A caller that passes its per-thread table first
+// compares the app's structures with the words last found for the same arrays, as it reads them (no copy, no
+// hash); a difference sends it the long way. A build that is not Cacheable is never stored, and a
 // lookup gives up on it as soon as the signature shows it, without hashing. Signatures of up to kLocalWords words (builds of up
 // to two geometries) are first looked up in a small per-thread table, which needs no lock at all; the rest,
 // and per-thread misses, take one shard's shared lock. A miss of both asks the driver through the next
@@ -89,6 +91,23 @@ class BuildSizeCache {
     static constexpr std::size_t kSlots = 64;
     Entry entries[kSlots];
     Entry& SlotFor(uint64_t hash) { return entries[hash & (kSlots - 1)]; }
+
+    // The signatures last found for an info's geometry and count arrays (a frame records the same builds from
+    // the same arrays call after call). Only a hint of where to look: a lookup compares the app's structures
+    // with the stored words as it reads them (no copy, no hash), and goes the long way at the first difference.
+    struct ByArrays {
+      uint64_t cache_id = 0;  // 0: empty
+      const void* geometries = nullptr;  // pGeometries or ppGeometries
+      const uint32_t* counts = nullptr;
+      std::vector<uint64_t> words;  // the signature, padded with zeros; keeps its capacity
+      std::size_t count = 0;        // words of the signature
+      BuildSizes sizes;
+    };
+    static constexpr std::size_t kArraySlots = 64;
+    ByArrays by_arrays[kArraySlots];
+    ByArrays& ArraySlotFor(const void* geometries) {
+      return by_arrays[(reinterpret_cast<uint64_t>(geometries) * 0x9e3779b97f4a7c15ull) >> 58];
+    }
   };
 
   // The cached sizes of this build, if it was queried before.
@@ -124,6 +143,9 @@ class BuildSizeCache {
 
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
+  // Remembers a signature by its arrays in the calling thread's table.
+  void RememberByArrays(ThreadTable& table, const BuildSignature& signature, const uint64_t* words, std::size_t count,
+                        const BuildSizes& sizes) const;
   // Stores a hit in the calling thread's table.
   void RememberLocally(ThreadTable& table, uint64_t hash, const uint64_t* words, std::size_t count,
                        const BuildSizes& sizes) const;
