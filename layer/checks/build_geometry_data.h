@@ -36,7 +36,7 @@ template <typename Judge>
       } else if ((tri.vertexStride & (alignment - 1)) != 0) {
         skip |= broken(DataRule::kStrideMultiple);
       }
-      const std::optional<VkFormatFeatureFlags> features = ctx.state.format_features.BufferFeatures(tri.vertexFormat);
+      const std::optional<VkFormatFeatureFlags>& features = f.features;
       if (!features) {
         skip |= judge.Unknown();
       } else if (!(*features & VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR)) {

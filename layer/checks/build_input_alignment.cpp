@@ -82,6 +82,7 @@ bool ValidateIndirectArrays(const CheckContext& ctx, const BuildCommand& cmd) {
 bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos || cmd.is_host()) return false;
   ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   bool skip = false;
   // Infos in which the command's geometry pass found nothing for these rules are not walked again.
   const uint32_t walked = resolved.walks() & kWalkInputAlignment ? cmd.info_count : 0;
@@ -90,7 +91,7 @@ bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, co
     if (!(resolved.info(i).walks & kWalkInputAlignment) || !GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
       const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
-      if (geometry) skip |= InputAlignmentRules(ctx, cmd, i, j, FactsOf(*geometry), judge);
+      if (geometry) skip |= InputAlignmentRules(ctx, cmd, i, j, facts.Read(*geometry), judge);
     }
   }
   if (cmd.is_indirect()) skip |= ValidateIndirectArrays(ctx, cmd);

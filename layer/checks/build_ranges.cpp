@@ -118,6 +118,7 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
 bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos || !cmd.ranges || !(resolved.walks() & kWalkRanges)) return false;
   ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
@@ -126,7 +127,7 @@ bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const
     if (!(resolved.info(i).walks & kWalkRanges) || !ranges || !GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
       const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
-      if (geometry) skip |= RangeRules(ctx, cmd, i, j, FactsOf(*geometry), ranges[j], judge);
+      if (geometry) skip |= RangeRules(ctx, cmd, i, j, facts.Read(*geometry), ranges[j], judge);
     }
   }
   return skip;

@@ -72,10 +72,11 @@ bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, ui
     return false;  // counts not given: another rule's business
   }
   ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
-    if (g) skip |= InstanceCountRule(ctx, cmd, i, j, FactsOf(*g), judge);
+    if (g) skip |= InstanceCountRule(ctx, cmd, i, j, facts.Read(*g), judge);
   }
   return skip;
 }

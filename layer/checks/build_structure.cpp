@@ -76,11 +76,12 @@ bool ValidateGeometries(const CheckContext& ctx, const BuildCommand& cmd, uint32
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (!GeometriesWalkable(ctx, info)) return false;
   ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   StructureGeometryRules<ReportingJudge> rules(ctx, cmd, i);
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
-    if (geometry) skip |= rules.Geometry(j, FactsOf(*geometry), judge);
+    if (geometry) skip |= rules.Geometry(j, facts.Read(*geometry), judge);
   }
   skip |= rules.Finish(judge);
   return skip;
