@@ -1,5 +1,8 @@
 #include "build_validation.h"
 
+#include <iterator>
+#include <utility>
+
 #include "build_alignment.h"
 #include "build_features.h"
 #include "build_handles.h"
@@ -42,16 +45,25 @@ constexpr BuildFamily kBuildFamilies[] = {
     {kCheckHost, &ValidateBuildHost, true},
 };
 
+// The table walked at compile time: each family is a direct call behind its settings test (a loop over the
+// table made an indirect call per family and reloaded each entry).
+template <std::size_t... k>
+bool RunFamilies(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved,
+                 std::index_sequence<k...>) {
+  bool skip = false;
+  const auto run = [&](const BuildFamily& f) {
+    if (ctx.Enabled(f.family) && (!f.host_only || cmd.is_host())) skip |= f.validate(ctx, cmd, resolved);
+  };
+  (run(kBuildFamilies[k]), ...);
+  return skip;
+}
+
 }  // namespace
 
 bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
   const CheckThreadLease thread;  // the one thread_local access of the call
   const ResolvedBuild resolved(ctx, cmd, thread.data());
-  bool skip = false;
-  for (const BuildFamily& f : kBuildFamilies) {
-    if (ctx.Enabled(f.family) && (!f.host_only || cmd.is_host())) skip |= f.validate(ctx, cmd, resolved);
-  }
-  return skip;
+  return RunFamilies(ctx, cmd, resolved, std::make_index_sequence<std::size(kBuildFamilies)>());
 }
 
 }  // namespace asval
