@@ -33,6 +33,10 @@ enum GeometryWalk : uint8_t {
 };
 
 struct ResolvedInfo {
+  // User-provided, so that value-initialization (ResolvedInfo(), vector::resize) runs the member initializers
+  // only, without zeroing the whole record first.
+  ResolvedInfo() {}
+
   // The families that must walk this info's geometries themselves: the geometry pass (geometry_pass.h) found
   // something to report or count for them, or did not screen this info. The others' rules found nothing.
   uint8_t walks = kWalkAll;
