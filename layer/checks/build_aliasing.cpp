@@ -202,24 +202,41 @@ void SortSpans(std::vector<AccessSpan>& spans) {
   }
 }
 
-// Up to this many spans, a command whose spans are pairwise disjoint (or in different memory) is found so by
-// comparing every pair, without the sort and the sweep: the sweep could report nothing. Any pair that might
-// overlap sends the command to the sweep, which then reports exactly what it always does.
+// Whether the sweep certainly has nothing to report, found without sorting: up to kPairwiseSpans spans, no two
+// overlap (every pair compared); up to kSpacesSpans spans, no two lie in the same memory (a small set of memory
+// handles on the stack: apps that give each structure and each scratch its own allocation). Either way a
+// possible overlap sends the command to the sort and sweep, which then report exactly what they always do.
 constexpr size_t kPairwiseSpans = 4;
+constexpr size_t kSpacesSpans = 64;
 
-bool PairwiseDisjoint(const std::vector<AccessSpan>& spans) {
-  for (size_t a = 0; a < spans.size(); ++a) {
-    for (size_t b = a + 1; b < spans.size(); ++b) {
-      const AccessSpan& x = spans[a];
-      const AccessSpan& y = spans[b];
-      if (SameSpace(x, y) && x.begin < y.end && y.begin < x.end) return false;
+bool CertainlyDisjoint(const std::vector<AccessSpan>& spans) {
+  if (spans.size() <= kPairwiseSpans) {
+    for (size_t a = 0; a < spans.size(); ++a) {
+      for (size_t b = a + 1; b < spans.size(); ++b) {
+        const AccessSpan& x = spans[a];
+        const AccessSpan& y = spans[b];
+        if (SameSpace(x, y) && x.begin < y.end && y.begin < x.end) return false;
+      }
     }
+    return true;
+  }
+  if (spans.size() > kSpacesSpans) return false;
+  constexpr uint32_t kSlots = 2 * kSpacesSpans;  // at most half full
+  static_assert(kSlots == 128, "the slot is the top 7 bits of the hash");
+  uint64_t spaces[kSlots] = {};  // 0 (kHostSpace) is an empty slot: host spans make this screen give up
+  for (const AccessSpan& s : spans) {
+    if (s.space == kHostSpace) return false;
+    uint32_t k = static_cast<uint32_t>((s.space * 0x9e3779b97f4a7c15ull) >> 57);
+    for (; spaces[k]; k = (k + 1) & (kSlots - 1)) {
+      if (spaces[k] == s.space) return false;
+    }
+    spaces[k] = s.space;
   }
   return true;
 }
 
 bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
-  if (w.spans.size() <= kPairwiseSpans && PairwiseDisjoint(w.spans)) return false;
+  if (CertainlyDisjoint(w.spans)) return false;
   SortSpans(w.spans);
   bool skip = false;
   int findings = 0;
