@@ -60,10 +60,14 @@ bool RunFamilies(const CheckContext& ctx, const BuildCommand& cmd, const Resolve
 
 }  // namespace
 
-bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
-  const CheckThreadLease thread;  // the one thread_local access of the call
-  const ResolvedBuild resolved(ctx, cmd, thread.data());
+bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd, CheckThreadData& thread) {
+  const ResolvedBuild resolved(ctx, cmd, thread);
   return RunFamilies(ctx, cmd, resolved, std::make_index_sequence<std::size(kBuildFamilies)>());
+}
+
+bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd) {
+  const CheckThreadLease thread;
+  return ValidateBuildCommand(ctx, cmd, thread.data());
 }
 
 }  // namespace asval

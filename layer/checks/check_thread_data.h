@@ -1,8 +1,9 @@
 #pragma once
-// Everything the build checks keep per thread from one call to the next, in one place: the buffer and
-// structure memos, the per-info records of calls of many infos, the aliasing sweep's buffers and the size
-// cache's table of recent hits. One thread_local, reached once per call (each thread_local of a shared library
-// costs a __tls_get_addr call per access). A call made from inside an app callback during another call on the
+// Everything the build commands' hot path keeps per thread from one call to the next, in one place: the buffer
+// and structure memos, the per-info records of calls of many infos, the aliasing sweep's buffers, the size
+// cache's table of recent hits, and the recorder's last command buffer (post-record, layer/state). One
+// thread_local, reached once per call by the hook (each thread_local of a shared library costs a __tls_get_addr
+// call per access). A call made from inside an app callback during another call on the
 // same thread (a report's callback that records a build) gets data of its own, so the outer call's records
 // stay as they were.
 #include <memory>
@@ -10,6 +11,7 @@
 
 #include "buffer_memo.h"
 #include "build_size_cache.h"
+#include "history_recorder.h"
 #include "resolved_build.h"
 #include "structure_memo.h"
 
@@ -26,6 +28,7 @@ struct CheckThreadData {
   BuildSizeCache::ThreadTable sizes;
   std::vector<ResolvedInfo> infos;  // the per-info records of calls of more infos than ResolvedBuild keeps inline
   std::unique_ptr<AliasingWorkspace> aliasing;  // made on the thread's first sweep
+  LastRecordedBuild last_recorded;  // RecordCmdBuild's memo
   bool in_use = false;
 };
 

@@ -16,22 +16,18 @@ std::shared_ptr<CommandBufferState> Recording(DeviceState& state, VkCommandBuffe
   return state.command_buffers.Find(cb);
 }
 
-// The same for the build commands, the hot path: the command buffer this thread recorded a build into last is
-// kept, with the command-buffer map's change stamp at that time. While the stamp reads the same, no command
-// buffer was allocated or freed since, so the map still holds that very CommandBufferState, and it stays alive
-// for this call: the app externally synchronizes the command buffer it records into, so it cannot be freed
-// meanwhile. No map lookup and no reference count per recorded build.
-CommandBufferState* RecordingBuild(DeviceState& state, VkCommandBuffer cb) {
+// The same for the build commands, the hot path: through the thread's memo of the last command buffer
+// (LastRecordedBuild, history_recorder.h).
+CommandBufferState* RecordingBuild(DeviceState& state, VkCommandBuffer cb, LastRecordedBuild& last) {
   if (!state.history_tracked) return nullptr;
-  struct LastRecorded {
-    StampValue stamp;  // of the map it came from (ids are never reused: another device's map never matches)
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    CommandBufferState* state = nullptr;  // null: the layer does not know cb
-  };
-  thread_local LastRecorded last;
   const StampValue stamp = state.command_buffers.stamp();
-  if (last.cb != cb || last.stamp != stamp) last = LastRecorded{stamp, cb, state.command_buffers.Find(cb).get()};
+  if (last.cb != cb || last.stamp != stamp) last = LastRecordedBuild{stamp, cb, state.command_buffers.Find(cb).get()};
   return last.state;
+}
+
+LastRecordedBuild& ThisThreadsLastRecordedBuild() {
+  thread_local LastRecordedBuild last;
+  return last;
 }
 
 // Runs an append; an allocation failure leaves the recording marked lost rather than silently incomplete.
@@ -114,8 +110,8 @@ void ApplyNow(DeviceState& state, const OpBatch& batch) {
 
 void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
-  CommandBufferState* recording = RecordingBuild(state, cb);
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last) {
+  CommandBufferState* recording = RecordingBuild(state, cb, last ? *last : ThisThreadsLastRecordedBuild());
   if (!recording || !infos) return;
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
   Guarded(*recording, [&] { recording->recording.AppendBuilds(origin, info_count, infos, ranges); });
