@@ -123,10 +123,12 @@ bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, 
     return true;
   }
   const VkDeviceAddress address = info.scratchData.deviceAddress;
-  KnownBuffer buffer = r.scratch_buffer;
-  if (!r.scratch_in_storage && !memo.Holding(state, address, r.scratch_bytes, 0, &buffer)) {
+  // The buffer the resolution found, else (a scratch outside STORAGE_BUFFER buffers) any holding it.
+  const KnownBuffer* held = r.scratch_in_storage ? &r.scratch_buffer : nullptr;
+  if (!held && !(held = memo.Held(state, address, r.scratch_bytes, 0))) {
     return false;  // not in one buffer: the addresses family reports it
   }
+  const KnownBuffer& buffer = *held;
   if (!buffer.bound) return false;
   const VkDeviceSize begin = SaturatingAdd(buffer.memory_offset, address - buffer.base);
   *out = AccessSpan{reinterpret_cast<uint64_t>(buffer.memory), begin, SaturatingAdd(begin, r.scratch_bytes),

@@ -39,9 +39,9 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
 
 // pInfos-03707 / 03708: the structure's buffer is bound. Unknown buffers and sparse buffers (bound through
 // vkQueueBindSparse, which the layer does not follow) are skipped and counted.
-bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const AccelerationStructureState& as,
-                   const char* vuid, const char* field) {
-  if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup
+[[gnu::noinline]] bool ValidateBoundByLookup(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                             const AccelerationStructureState& as, const char* vuid,
+                                             const char* field) {
   const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, as);
   if (!buffer || (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
     CountUnknownState(ctx);
@@ -52,6 +52,12 @@ bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                      "(0x{:x}) was created on VkBuffer 0x{:x}, which is not bound to device memory (no "
                      "vkBindBufferMemory or vkBindBufferMemory2 for it succeeded).",
                      reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
+}
+
+inline bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                          const AccelerationStructureState& as, const char* vuid, const char* field) {
+  if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup (inline, no call)
+  return ValidateBoundByLookup(ctx, cmd, i, as, vuid, field);
 }
 
 bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {

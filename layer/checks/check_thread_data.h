@@ -6,6 +6,7 @@
 // call per access). A call made from inside an app callback during another call on the
 // same thread (a report's callback that records a build) gets data of its own, so the outer call's records
 // stay as they were.
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -29,6 +30,13 @@ struct CheckThreadData {
   std::vector<ResolvedInfo> infos;  // the per-info records of calls of more infos than ResolvedBuild keeps inline
   std::unique_ptr<AliasingWorkspace> aliasing;  // made on the thread's first sweep
   LastRecordedBuild last_recorded;  // RecordCmdBuild's memo
+  // Per info index (the first kHintedInfos), the buffer-memo entries that answered its scratch and its
+  // destination's buffer last call (BufferMemo::HoldingHinted, FindOfStructureHinted): a frame records the same
+  // builds call after call.
+  static constexpr uint32_t kHintedInfos = 64;
+  uint8_t scratch_hints[kHintedInfos] = {};
+  uint8_t dst_buffer_hints[kHintedInfos] = {};
+  uint8_t spare_hint = 0;  // for infos beyond kHintedInfos (a hint of no use, never wrong)
   bool in_use = false;
 };
 
