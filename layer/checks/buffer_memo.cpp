@@ -48,6 +48,7 @@ bool BufferMemo::Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* ou
   const unsigned slot = SlotOf(key);
   if (const int e = handle_entries_[slot] - 1; e >= 0 && handle_keys_[slot] == key && entries_[e].buffer == buffer) {
     *out = entries_[e];
+    last_found_ = static_cast<uint8_t>(e);
     return true;
   }
   for (int k = 0; k < count_; ++k) {
@@ -55,6 +56,7 @@ bool BufferMemo::Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* ou
       handle_keys_[slot] = key;
       handle_entries_[slot] = static_cast<uint8_t>(k + 1);
       *out = entries_[k];
+      last_found_ = static_cast<uint8_t>(k);
       return true;
     }
   }
@@ -70,6 +72,7 @@ bool BufferMemo::Find(const DeviceState& state, VkBuffer buffer, KnownBuffer* ou
   const int e = Remember(*out);
   handle_keys_[slot] = key;
   handle_entries_[slot] = static_cast<uint8_t>(e + 1);
+  last_found_ = static_cast<uint8_t>(e);
   return true;
 }
 

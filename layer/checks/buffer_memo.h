@@ -60,6 +60,33 @@ class BufferMemo {
     }
     return HeldSlow(state, address, bytes, usage);
   }
+  // Holding and FindOfStructure for a lookup that recurs from call to call at the same place (pInfos[i]'s
+  // scratch, its destination's buffer): `hint` is the entry that answered it last (any value at first), tried
+  // before everything else and updated. Any entry that serves is a right answer (every entry is valid for the
+  // maps as they are), so a stale hint only costs the usual lookup.
+  bool HoldingHinted(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                     uint8_t& hint, KnownBuffer* out) {
+    if (hint < count_ && Serves(entries_[hint], address, bytes, usage)) {
+      *out = entries_[hint];
+      return true;
+    }
+    const KnownBuffer* held = Held(state, address, bytes, usage);
+    if (!held) return false;
+    hint = static_cast<uint8_t>(held - entries_.data());
+    *out = *held;
+    return true;
+  }
+  bool FindOfStructureHinted(const DeviceState& state, const AccelerationStructureState& structure, uint8_t& hint,
+                             KnownBuffer* out) {
+    if (hint < count_ && entries_[hint].buffer == structure.buffer) {
+      *out = entries_[hint];
+      return out->id == structure.buffer_id;
+    }
+    if (!Find(state, structure.buffer, out)) return false;
+    hint = last_found_;
+    return out->id == structure.buffer_id;
+  }
+
   // Empties the memo unless it was filled from these very maps, unchanged since. Call before any lookup of a
   // command.
   void Sync(const DeviceState& state) {
@@ -100,6 +127,7 @@ class BufferMemo {
 
   std::array<KnownBuffer, kEntries> entries_{};
   int count_ = 0;
+  uint8_t last_found_ = 0;  // the entry Find answered from last
   int last_ = 0;    // the entry Held returned last
   int before_ = 0;  // and the one before it
   std::array<uint64_t, kSlots> address_keys_{};  // the start address a lookup asked for

@@ -5,39 +5,12 @@
 
 #include "buffer_lookup.h"
 #include "buffer_memo.h"
+#include "check_thread_data.h"
 #include "build_report.h"
 #include "build_sizes.h"
 #include "host_instances.h"
 
 namespace asval {
-
-namespace {
-
-// What a span of memory is to its info. The order matters only for naming pairs (lower kind first).
-enum class SpanKind : uint8_t { kDst, kSrc, kScratch, kReferenced };
-
-// Bytes one info accesses: [begin, end) of a VkDeviceMemory (space = its handle), or of the host's address
-// space (host builds' scratch; space = kHostSpace: no VkDeviceMemory handle is 0).
-constexpr uint64_t kHostSpace = 0;
-struct AccessSpan {
-  uint64_t space;
-  VkDeviceSize begin;
-  VkDeviceSize end;
-  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
-  uint32_t info;
-  SpanKind kind;
-};
-
-}  // namespace
-
-// Per-thread buffers, reused from call to call so that a steady stream of builds allocates nothing.
-struct AliasingWorkspace {
-  bool in_use = false;
-  std::vector<AccessSpan> spans;
-  std::vector<uint32_t> active;
-  std::vector<uint64_t> references;
-  std::vector<std::pair<uint64_t, uint32_t>> destinations;  // (handle, info), sorted
-};
 
 namespace {
 
@@ -150,10 +123,12 @@ bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, 
     return true;
   }
   const VkDeviceAddress address = info.scratchData.deviceAddress;
-  KnownBuffer buffer = r.scratch_buffer;
-  if (!r.scratch_in_storage && !memo.Holding(state, address, r.scratch_bytes, 0, &buffer)) {
+  // The buffer the resolution found, else (a scratch outside STORAGE_BUFFER buffers) any holding it.
+  const KnownBuffer* held = r.scratch_in_storage ? &r.scratch_buffer : nullptr;
+  if (!held && !(held = memo.Held(state, address, r.scratch_bytes, 0))) {
     return false;  // not in one buffer: the addresses family reports it
   }
+  const KnownBuffer& buffer = *held;
   if (!buffer.bound) return false;
   const VkDeviceSize begin = SaturatingAdd(buffer.memory_offset, address - buffer.base);
   *out = AccessSpan{reinterpret_cast<uint64_t>(buffer.memory), begin, SaturatingAdd(begin, r.scratch_bytes),
@@ -174,7 +149,7 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
     CountUnknownState(ctx);
   }
   if (info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR && info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    if (StructureSpan(ctx.state, memo, r.src.get(), r.sizes->acceleration_structure_size, i, SpanKind::kSrc,
+    if (StructureSpan(ctx.state, memo, r.src, r.sizes->acceleration_structure_size, i, SpanKind::kSrc,
                       &span)) {
       w.spans.push_back(span);
     } else {
@@ -217,7 +192,8 @@ constexpr size_t kFewSpans = 16;
 
 void SortSpans(std::vector<AccessSpan>& spans) {
   if (spans.size() > kFewSpans) {
-    std::sort(spans.begin(), spans.end(), SpanBefore);
+    // Through a lambda, so that the comparison is inlined into the sort (a function pointer is called per comparison).
+    std::sort(spans.begin(), spans.end(), [](const AccessSpan& x, const AccessSpan& y) { return SpanBefore(x, y); });
     return;
   }
   for (size_t k = 1; k < spans.size(); ++k) {
@@ -228,7 +204,41 @@ void SortSpans(std::vector<AccessSpan>& spans) {
   }
 }
 
+// Whether the sweep certainly has nothing to report, found without sorting: up to kPairwiseSpans spans, no two
+// overlap (every pair compared); up to kSpacesSpans spans, no two lie in the same memory (a small set of memory
+// handles on the stack: apps that give each structure and each scratch its own allocation). Either way a
+// possible overlap sends the command to the sort and sweep, which then report exactly what they always do.
+constexpr size_t kPairwiseSpans = 4;
+constexpr size_t kSpacesSpans = 64;
+
+bool CertainlyDisjoint(const std::vector<AccessSpan>& spans) {
+  if (spans.size() <= kPairwiseSpans) {
+    for (size_t a = 0; a < spans.size(); ++a) {
+      for (size_t b = a + 1; b < spans.size(); ++b) {
+        const AccessSpan& x = spans[a];
+        const AccessSpan& y = spans[b];
+        if (SameSpace(x, y) && x.begin < y.end && y.begin < x.end) return false;
+      }
+    }
+    return true;
+  }
+  if (spans.size() > kSpacesSpans) return false;
+  constexpr uint32_t kSlots = 2 * kSpacesSpans;  // at most half full
+  static_assert(kSlots == 128, "the slot is the top 7 bits of the hash");
+  uint64_t spaces[kSlots] = {};  // 0 (kHostSpace) is an empty slot: host spans make this screen give up
+  for (const AccessSpan& s : spans) {
+    if (s.space == kHostSpace) return false;
+    uint32_t k = static_cast<uint32_t>((s.space * 0x9e3779b97f4a7c15ull) >> 57);
+    for (; spaces[k]; k = (k + 1) & (kSlots - 1)) {
+      if (spaces[k] == s.space) return false;
+    }
+    spaces[k] = s.space;
+  }
+  return true;
+}
+
 bool SweepOverlaps(const CheckContext& ctx, const BuildCommand& cmd, Workspace& w) {
+  if (CertainlyDisjoint(w.spans)) return false;
   SortSpans(w.spans);
   bool skip = false;
   int findings = 0;
@@ -278,7 +288,7 @@ bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, ui
   AccessSpan src, dst;
   const VkDeviceSize whole = ~VkDeviceSize{0};
   if (!r.dst || !r.dst_buffer_known || !StructureSpan(*r.dst, r.dst_buffer, whole, i, SpanKind::kDst, &dst) ||
-      !StructureSpan(ctx.state, memo, r.src.get(), whole, i, SpanKind::kSrc, &src)) {
+      !StructureSpan(ctx.state, memo, r.src, whole, i, SpanKind::kSrc, &src)) {
     CountUnknownState(ctx);
     return false;
   }
@@ -328,29 +338,10 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
 
 }  // namespace
 
-namespace {
-
-// This thread's workspace, or null while a sweep on this thread already holds it (an app callback that
-// records a build from inside a report): the nested sweep then works in a buffer of its own.
-AliasingWorkspace* TakeThreadWorkspace() {
-  thread_local AliasingWorkspace workspace;
-  if (workspace.in_use) return nullptr;
-  workspace.in_use = true;
-  return &workspace;
-}
-
-}  // namespace
-
-AliasingSweep::AliasingSweep() : w_(TakeThreadWorkspace()) {
-  if (!w_) {
-    owned_ = std::make_unique<AliasingWorkspace>();
-    w_ = owned_.get();
-  }
+AliasingSweep::AliasingSweep(CheckThreadData& thread) {
+  if (!thread.aliasing) thread.aliasing = std::make_unique<AliasingWorkspace>();
+  w_ = thread.aliasing.get();
   w_->spans.clear();
-}
-
-AliasingSweep::~AliasingSweep() {
-  if (!owned_) w_->in_use = false;
 }
 
 bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,

@@ -14,7 +14,10 @@
 // all as the driver reports them for this build. They are compared as VkDeviceMemory offsets, so two buffers
 // over one allocation alias. The spans are sorted and swept once: O(n log n) for n infos, no all-pairs loop.
 // In-place updates (src == dst) are valid: an info's destination and its own source may be the same bytes.
+#include <cstdint>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "buffer_memo.h"
 #include "build_command.h"
@@ -23,14 +26,36 @@
 
 namespace asval {
 
-struct AliasingWorkspace;
+struct CheckThreadData;
 
-// One command's sweep (called by ValidateBuildMemory): AddInfo for each info, then Finish. Uses this thread's
-// reusable buffers, so a steady stream of calls allocates nothing.
+// What a span of memory is to its info. The order matters only for naming pairs (lower kind first).
+enum class SpanKind : uint8_t { kDst, kSrc, kScratch, kReferenced };
+
+// Bytes one info accesses: [begin, end) of a VkDeviceMemory (space = its handle), or of the host's address
+// space (host builds' scratch; space = kHostSpace: no VkDeviceMemory handle is 0).
+inline constexpr uint64_t kHostSpace = 0;
+struct AccessSpan {
+  uint64_t space;
+  VkDeviceSize begin;
+  VkDeviceSize end;
+  VkAccelerationStructureKHR structure;  // kDst / kSrc / kReferenced
+  uint32_t info;
+  SpanKind kind;
+};
+
+// The sweep's buffers, kept in the thread's data (check_thread_data.h) from call to call, so that a steady
+// stream of builds allocates nothing.
+struct AliasingWorkspace {
+  std::vector<AccessSpan> spans;
+  std::vector<uint32_t> active;
+  std::vector<uint64_t> references;
+  std::vector<std::pair<uint64_t, uint32_t>> destinations;  // (handle, info), sorted
+};
+
+// One command's sweep (called by ValidateBuildMemory): AddInfo for each info, then Finish.
 class AliasingSweep {
  public:
-  AliasingSweep();
-  ~AliasingSweep();
+  explicit AliasingSweep(CheckThreadData& thread);
   AliasingSweep(const AliasingSweep&) = delete;
   AliasingSweep& operator=(const AliasingSweep&) = delete;
   // Collects the spans pInfos[i] accesses (each one the layer cannot place is left out and counted) and
@@ -42,7 +67,6 @@ class AliasingSweep {
 
  private:
   AliasingWorkspace* w_;
-  std::unique_ptr<AliasingWorkspace> owned_;  // only when the thread's workspace is already in use
 };
 
 }  // namespace asval

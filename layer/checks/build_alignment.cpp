@@ -40,11 +40,11 @@ bool ValidateScratchAlignment(const CheckContext& ctx, const BuildCommand& cmd) 
 
 }  // namespace
 
-bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd) {
+bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
   bool skip = false;
   if (!cmd.is_host()) skip |= ValidateScratchAlignment(ctx, cmd);
-  skip |= ValidateInputAlignment(ctx, cmd);
+  skip |= ValidateInputAlignment(ctx, cmd, resolved);
   return skip;
 }
 

@@ -2,6 +2,7 @@
 // Alignment rules of the acceleration-structure build commands (family "alignment").
 #include "build_command.h"
 #include "check_context.h"
+#include "resolved_build.h"
 
 namespace asval {
 
@@ -9,6 +10,6 @@ namespace asval {
 // is a multiple of minAccelerationStructureScratchOffsetAlignment (device builds only: host scratch is a
 // host pointer).
 // Then the alignment of the geometry inputs and of the indirect arrays (build_input_alignment.h).
-bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd);
+bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved);
 
 }  // namespace asval

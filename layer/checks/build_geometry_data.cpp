@@ -8,15 +8,8 @@
 
 namespace asval {
 
-namespace {
-
-constexpr VkDeviceSize kMaxStride = std::numeric_limits<uint32_t>::max();
-
-// The data rules, named for the reporting half: the clean path passes only this and indices.
-enum class DataRule { kStrideMultiple, kStrideMax, kVertexFormat, kIndexType, kAabbStride, kAabbStrideMax };
-
-[[gnu::cold, gnu::noinline]] bool ReportData(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                                             DataRule rule, VkFormatFeatureFlags features = 0) {
+bool ReportGeometryData(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, DataRule rule,
+                        VkFormatFeatureFlags features) {
   const VkAccelerationStructureGeometryKHR& g = *GeometryAt(cmd.infos[i], j);
   const VkAccelerationStructureGeometryTrianglesDataKHR& tri = g.geometry.triangles;
   const auto triangles = [&](const char* field) {
@@ -58,51 +51,6 @@ enum class DataRule { kStrideMultiple, kStrideMax, kVertexFormat, kIndexType, kA
                          "({}) is greater than 2^32-1.", g.geometry.aabbs.stride);
   }
   return false;
-}
-
-bool ValidateTriangles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                       const VkAccelerationStructureGeometryTrianglesDataKHR& tri) {
-  bool skip = false;
-  if (tri.vertexStride > kMaxStride) skip |= ReportData(ctx, cmd, i, j, DataRule::kStrideMax);
-  const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
-  if (alignment.bytes == 0) {
-    CountUnknownState(ctx);  // vertexFormat-03797 speaks about such a format
-  } else if ((tri.vertexStride & (alignment.bytes - 1)) != 0) {
-    skip |= ReportData(ctx, cmd, i, j, DataRule::kStrideMultiple);
-  }
-  const std::optional<VkFormatFeatureFlags> features = ctx.state.format_features.BufferFeatures(tri.vertexFormat);
-  if (!features) {
-    CountUnknownState(ctx);
-  } else if (!(*features & VK_FORMAT_FEATURE_ACCELERATION_STRUCTURE_VERTEX_BUFFER_BIT_KHR)) {
-    skip |= ReportData(ctx, cmd, i, j, DataRule::kVertexFormat, *features);
-  }
-  if (tri.indexType != VK_INDEX_TYPE_UINT16 && tri.indexType != VK_INDEX_TYPE_UINT32 &&
-      tri.indexType != VK_INDEX_TYPE_NONE_KHR) {
-    skip |= ReportData(ctx, cmd, i, j, DataRule::kIndexType);
-  }
-  return skip;
-}
-
-bool ValidateAabbs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                   const VkAccelerationStructureGeometryAabbsDataKHR& aabbs) {
-  bool skip = false;
-  if ((aabbs.stride & 7) != 0) skip |= ReportData(ctx, cmd, i, j, DataRule::kAabbStride);
-  if (aabbs.stride > kMaxStride) skip |= ReportData(ctx, cmd, i, j, DataRule::kAabbStrideMax);
-  return skip;
-}
-
-}  // namespace
-
-bool ValidateGeometryData(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                          const VkAccelerationStructureGeometryKHR& geometry) {
-  switch (geometry.geometryType) {
-    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
-      return ValidateTriangles(ctx, cmd, i, j, geometry.geometry.triangles);
-    case VK_GEOMETRY_TYPE_AABBS_KHR:
-      return ValidateAabbs(ctx, cmd, i, j, geometry.geometry.aabbs);
-    default:
-      return false;  // instances have no data rule here; types of newer extensions are not this layer's
-  }
 }
 
 }  // namespace asval

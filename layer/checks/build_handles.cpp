@@ -39,9 +39,9 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
 
 // pInfos-03707 / 03708: the structure's buffer is bound. Unknown buffers and sparse buffers (bound through
 // vkQueueBindSparse, which the layer does not follow) are skipped and counted.
-bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const AccelerationStructureState& as,
-                   const char* vuid, const char* field) {
-  if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup
+[[gnu::noinline]] bool ValidateBoundByLookup(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                             const AccelerationStructureState& as, const char* vuid,
+                                             const char* field) {
   const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, as);
   if (!buffer || (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
     CountUnknownState(ctx);
@@ -54,10 +54,16 @@ bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                      reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
 }
 
+inline bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                          const AccelerationStructureState& as, const char* vuid, const char* field) {
+  if (as.buffer_was_bound) return false;  // bound before the structure was created: no lookup (inline, no call)
+  return ValidateBoundByLookup(ctx, cmd, i, as, vuid, field);
+}
+
 bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
-  const AccelerationStructureState* dst = r.dst.get();
+  const AccelerationStructureState* dst = r.dst;
   if (!dst) {
     skip |= ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
                         [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
@@ -70,7 +76,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
     if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
   }
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
-    const AccelerationStructureState* src = r.src.get();
+    const AccelerationStructureState* src = r.src;
     if (!src) {
       skip |= ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
                           [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
@@ -106,9 +112,40 @@ using DstEntry = std::pair<VkAccelerationStructureKHR, uint32_t>;
                      reinterpret_cast<uint64_t>(cmd.infos[i].srcAccelerationStructure), other);
 }
 
+// Whether no two infos share a destination and no info's source is any info's destination (in-place updates
+// included): then neither rule below has anything to say. One pass over a small open-addressing set on the
+// stack; a hit on either question sends the command to the rules, which find and report exactly what they
+// always do.
+bool HandlesCertainlyDistinct(const BuildCommand& cmd) {
+  constexpr uint32_t kSlots = 2 * kFewInfos;  // at most half full
+  static_assert(kSlots == 32, "slot_of takes the top 5 bits of the hash");
+  VkAccelerationStructureKHR set[kSlots] = {};
+  const auto slot_of = [](VkAccelerationStructureKHR h) {
+    return static_cast<uint32_t>((reinterpret_cast<uint64_t>(h) * 0x9e3779b97f4a7c15ull) >> 59);
+  };
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureKHR dst = cmd.infos[i].dstAccelerationStructure;
+    if (!dst) continue;
+    uint32_t k = slot_of(dst);
+    for (; set[k]; k = (k + 1) & (kSlots - 1)) {
+      if (set[k] == dst) return false;
+    }
+    set[k] = dst;
+  }
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const VkAccelerationStructureKHR src = cmd.infos[i].srcAccelerationStructure;
+    if (!src) continue;
+    for (uint32_t k = slot_of(src); set[k]; k = (k + 1) & (kSlots - 1)) {
+      if (set[k] == src) return false;
+    }
+  }
+  return true;
+}
+
 // dstAccelerationStructure-03698 and pInfos-03403 for a few infos: comparing every pair is cheaper than
 // sorting. Reports the same pairs as the sorted version (each against the lowest other index).
 bool ValidateDistinctHandlesFew(const CheckContext& ctx, const BuildCommand& cmd) {
+  if (HandlesCertainlyDistinct(cmd)) return false;
   bool skip = false;
   for (uint32_t k = 1; k < cmd.info_count; ++k) {
     const VkAccelerationStructureKHR dst = cmd.infos[k].dstAccelerationStructure;

@@ -13,7 +13,7 @@ bool ValidateBuildMemory(const CheckContext& ctx, const BuildCommand& cmd, const
   const bool addresses = ctx.Enabled(kCheckAddresses);
   const bool aliasing = ctx.Enabled(kCheckAliasing);
   std::optional<AliasingSweep> sweep;
-  if (aliasing) sweep.emplace();
+  if (aliasing) sweep.emplace(resolved.thread());
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const ResolvedInfo& r = resolved.info(i);

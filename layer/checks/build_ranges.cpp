@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "build_report.h"
+#include "rule_judge.h"
 #include "vertex_format_alignment.h"
 #include "vk_enum_string.h"
 
@@ -10,13 +11,42 @@ namespace asval {
 
 namespace {
 
-// The range rules, named for the reporting half: the clean path passes only this and indices, so it
-// materialises no message pieces in its own frame.
-enum class RangeRule { kIndexOffset, kVertexOffset, kTransformOffset, kAabbOffset, kInstanceOffset, kVertexCount,
-                       kLastVertex };
+// The largest of `count` indices of `size` bytes at `data` (which need not be aligned).
+uint32_t LargestIndex(const uint8_t* data, uint64_t count, int size) {
+  uint32_t largest = 0;
+  if (size == 2) {
+    for (uint64_t k = 0; k < count; ++k) {
+      uint16_t index;
+      std::memcpy(&index, data + k * 2, sizeof(index));
+      if (index > largest) largest = index;
+    }
+  } else {
+    for (uint64_t k = 0; k < count; ++k) {
+      uint32_t index;
+      std::memcpy(&index, data + k * 4, sizeof(index));
+      if (index > largest) largest = index;
+    }
+  }
+  return largest;
+}
 
-[[gnu::cold, gnu::noinline]] bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                                              RangeRule rule) {
+[[gnu::cold, gnu::noinline]] bool ReportLargestIndex(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                     uint32_t j, uint32_t largest) {
+  const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
+  const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
+  return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-maxVertex-10774",
+                     [&](std::string&) {
+                       return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
+                     },
+                     "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) plus the largest index the "
+                     "build reads ({}, among the {} {} indices at indexData.hostAddress + primitiveOffset {}).",
+                     tri.maxVertex, i, j, range.firstVertex, largest, uint64_t{range.primitiveCount} * 3,
+                     string_VkIndexType(tri.indexType), range.primitiveOffset);
+}
+
+}  // namespace
+
+bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, RangeRule rule) {
   const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
   const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
   // "ppBuildRangeInfos[i][j].<field>": a path element with two indices, built here.
@@ -74,39 +104,6 @@ enum class RangeRule { kIndexOffset, kVertexOffset, kTransformOffset, kAabbOffse
   return false;
 }
 
-// The largest of `count` indices of `size` bytes at `data` (which need not be aligned).
-uint32_t LargestIndex(const uint8_t* data, uint64_t count, int size) {
-  uint32_t largest = 0;
-  if (size == 2) {
-    for (uint64_t k = 0; k < count; ++k) {
-      uint16_t index;
-      std::memcpy(&index, data + k * 2, sizeof(index));
-      if (index > largest) largest = index;
-    }
-  } else {
-    for (uint64_t k = 0; k < count; ++k) {
-      uint32_t index;
-      std::memcpy(&index, data + k * 4, sizeof(index));
-      if (index > largest) largest = index;
-    }
-  }
-  return largest;
-}
-
-[[gnu::cold, gnu::noinline]] bool ReportLargestIndex(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                                                     uint32_t j, uint32_t largest) {
-  const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
-  const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
-  return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-maxVertex-10774",
-                     [&](std::string&) {
-                       return GeometryLocation(cmd, i, j).Field("geometry").Field("triangles").Field("maxVertex");
-                     },
-                     "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) plus the largest index the "
-                     "build reads ({}, among the {} {} indices at indexData.hostAddress + primitiveOffset {}).",
-                     tri.maxVertex, i, j, range.firstVertex, largest, uint64_t{range.primitiveCount} * 3,
-                     string_VkIndexType(tri.indexType), range.primitiveOffset);
-}
-
 // maxVertex-10774 for a host build: the indices are in host memory now, so the largest can be read.
 bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                                 const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
@@ -118,75 +115,19 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
   return ReportLargestIndex(ctx, cmd, i, j, largest);
 }
 
-bool ValidateNonIndexedRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                             const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
-                             const VkAccelerationStructureBuildRangeInfoKHR& range) {
-  bool skip = false;
-  const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
-  if (alignment.bytes == 0) {
-    CountUnknownState(ctx);
-  } else if ((range.primitiveOffset & (alignment.bytes - 1)) != 0) {
-    skip |= ReportRange(ctx, cmd, i, j, RangeRule::kVertexOffset);
-  }
-  // Nothing is read when there are no triangles (firstVertex then names no vertex).
-  if (range.primitiveCount == 0) return skip;
-  const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
-  if (vertices > uint64_t{tri.maxVertex} + 1) skip |= ReportRange(ctx, cmd, i, j, RangeRule::kVertexCount);
-  if (uint64_t{range.firstVertex} + vertices - 1 > tri.maxVertex) {
-    skip |= ReportRange(ctx, cmd, i, j, RangeRule::kLastVertex);
-  }
-  return skip;
-}
-
-bool ValidateTriangleRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                           const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
-                           const VkAccelerationStructureBuildRangeInfoKHR& range) {
-  bool skip = false;
-  const int index_size = IndexTypeSize(tri.indexType);
-  if (index_size == 0) {
-    skip |= ValidateNonIndexedRange(ctx, cmd, i, j, tri, range);
-  } else if (index_size == 2 || index_size == 4) {
-    if ((range.primitiveOffset & (index_size - 1)) != 0) {
-      skip |= ReportRange(ctx, cmd, i, j, RangeRule::kIndexOffset);
-    } else if (cmd.is_host()) {
-      // Indices read from a misaligned offset are not the app's indices: only an aligned range is judged.
-      skip |= ValidateIndexedVertexCount(ctx, cmd, i, j, tri, range, index_size);
-    }
-  }
-  // Other index types are indexType-03798's finding; their ranges are not judged.
-  if ((range.transformOffset & 15) != 0) skip |= ReportRange(ctx, cmd, i, j, RangeRule::kTransformOffset);
-  return skip;
-}
-
-bool ValidateRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
-                   const VkAccelerationStructureGeometryKHR& geometry,
-                   const VkAccelerationStructureBuildRangeInfoKHR& range) {
-  switch (geometry.geometryType) {
-    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
-      return ValidateTriangleRange(ctx, cmd, i, j, geometry.geometry.triangles, range);
-    case VK_GEOMETRY_TYPE_AABBS_KHR:
-      if ((range.primitiveOffset & 7) == 0) return false;
-      return ReportRange(ctx, cmd, i, j, RangeRule::kAabbOffset);
-    case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-      if ((range.primitiveOffset & 15) == 0) return false;
-      return ReportRange(ctx, cmd, i, j, RangeRule::kInstanceOffset);
-    default:
-      return false;  // geometry types of newer extensions have rules of their own
-  }
-}
-
-}  // namespace
-
-bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd) {
-  if (!cmd.infos || !cmd.ranges) return false;
+bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
+  if (!cmd.infos || !cmd.ranges || !(resolved.walks() & kWalkRanges)) return false;
+  ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
     const VkAccelerationStructureBuildRangeInfoKHR* ranges = cmd.ranges[i];
-    if (!ranges || !GeometriesWalkable(ctx, info)) continue;
+    // Infos in which the command's geometry pass found nothing for these rules are not walked again.
+    if (!(resolved.info(i).walks & kWalkRanges) || !ranges || !GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
       const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
-      if (geometry) skip |= ValidateRange(ctx, cmd, i, j, *geometry, ranges[j]);
+      if (geometry) skip |= RangeRules(ctx, cmd, i, j, facts.Read(*geometry), ranges[j], judge);
     }
   }
   return skip;

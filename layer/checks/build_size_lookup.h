@@ -22,8 +22,10 @@ bool SignatureOfInfo(const BuildCommand& cmd, uint32_t i, BuildSignature* out);
 bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature);
 
 // The sizes of pInfos[i] (cache, else one driver query). nullopt when they cannot be known: counts not given,
-// or the query would not be valid (see SizeQueryIsValid); the family that needed them counts the skip.
-std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i);
+// or the query would not be valid (see SizeQueryIsValid); the family that needed them counts the skip. table:
+// the caller's per-thread table of recent hits (null: the cache's own thread_local one).
+std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i,
+                                      BuildSizeCache::ThreadTable* table = nullptr);
 
 // True when pInfos[a] and pInfos[b] certainly have the same signature, without reading it: no extension chain,
 // the same header fields, and the very same geometry and count arrays (the app cannot change them during

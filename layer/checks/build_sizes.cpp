@@ -4,6 +4,7 @@
 
 #include "asval/vertex_formats.h"
 #include "build_report.h"
+#include "rule_judge.h"
 #include "vk_enum_string.h"
 
 namespace asval {
@@ -65,44 +66,17 @@ bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGe
   }
 }
 
-uint32_t InstanceGeometryCount(const BuildCommand& cmd, uint32_t i, uint32_t j) {
-  if (cmd.is_indirect()) return cmd.max_primitive_counts[i][j];
-  return cmd.ranges[i][j].primitiveCount;
-}
-
-// pInfos-03801: instance counts (primitive counts of instance geometries) within maxInstanceCount.
-[[gnu::cold, gnu::noinline]] bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                                                      uint32_t j, uint32_t count, uint64_t limit) {
-  return ReportBuild(ctx, cmd, i, "pInfos-03801",
-                     [&](std::string& storage) {
-                       if (cmd.is_indirect()) {
-                         storage = fmt::format("ppMaxPrimitiveCounts[{}][{}]", i, j);
-                       } else {
-                         storage = fmt::format("ppBuildRangeInfos[{}][{}].primitiveCount", i, j);
-                       }
-                       return cmd.Root().Field(storage.c_str());
-                     },
-                     "({}) is greater than VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxInstanceCount ({}); "
-                     "pInfos[{}].{}[{}] is a VK_GEOMETRY_TYPE_INSTANCES_KHR geometry.",
-                     count, limit, i, cmd.infos[i].pGeometries ? "pGeometries" : "ppGeometries", j);
-}
-
 bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (cmd.is_indirect() ? !cmd.max_primitive_counts || !cmd.max_primitive_counts[i] : !cmd.ranges || !cmd.ranges[i]) {
     return false;  // counts not given: another rule's business
   }
+  ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
-    if (!g || g->geometryType != VK_GEOMETRY_TYPE_INSTANCES_KHR) continue;
-    const uint64_t limit = ctx.state.properties.acceleration_structure.maxInstanceCount;
-    if (limit == 0) {
-      CountUnknownState(ctx);
-      continue;
-    }
-    const uint32_t count = InstanceGeometryCount(cmd, i, j);
-    if (count > limit) skip |= ReportInstanceCount(ctx, cmd, i, j, count, limit);
+    if (g) skip |= InstanceCountRule(ctx, cmd, i, j, facts.Read(*g), judge);
   }
   return skip;
 }
@@ -198,11 +172,13 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
   return primitives <= limits.maxPrimitiveCount;
 }
 
-std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i) {
+std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i,
+                                      BuildSizeCache::ThreadTable* table) {
   BuildSignature signature;
   BuildSizes sizes;
   if (SignatureOfInfo(cmd, i, &signature)) {
-    if (state.build_sizes.Find(signature, &sizes)) return sizes;
+    const bool found = table ? state.build_sizes.Find(signature, &sizes, *table) : state.build_sizes.Find(signature, &sizes);
+    if (found) return sizes;
     if (SizeQueryIsValid(state, signature)) {
       if (std::optional<BuildSizes> queried = state.build_sizes.Query(signature)) return queried;
     }
@@ -210,8 +186,27 @@ std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildComma
   return std::nullopt;
 }
 
+// pInfos-03801: instance counts (primitive counts of instance geometries) within maxInstanceCount.
+bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, uint32_t count,
+                         uint64_t limit) {
+  return ReportBuild(ctx, cmd, i, "pInfos-03801",
+                     [&](std::string& storage) {
+                       if (cmd.is_indirect()) {
+                         storage = fmt::format("ppMaxPrimitiveCounts[{}][{}]", i, j);
+                       } else {
+                         storage = fmt::format("ppBuildRangeInfos[{}][{}].primitiveCount", i, j);
+                       }
+                       return cmd.Root().Field(storage.c_str());
+                     },
+                     "({}) is greater than VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxInstanceCount ({}); "
+                     "pInfos[{}].{}[{}] is a VK_GEOMETRY_TYPE_INSTANCES_KHR geometry.",
+                     count, limit, i, cmd.infos[i].pGeometries ? "pGeometries" : "ppGeometries", j);
+}
+
 bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
-  return ValidateInstanceCounts(ctx, cmd, i) | ValidateDestinationSize(ctx, cmd, i, r);
+  // Infos in which the command's geometry pass found nothing for pInfos-03801 are not walked again.
+  const bool counts = (r.walks & kWalkInstanceCounts) && ValidateInstanceCounts(ctx, cmd, i);
+  return counts | ValidateDestinationSize(ctx, cmd, i, r);
 }
 
 }  // namespace asval

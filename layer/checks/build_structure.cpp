@@ -1,7 +1,7 @@
 #include "build_structure.h"
 
-#include "build_geometry_data.h"
 #include "build_report.h"
+#include "rule_judge.h"
 #include "vk_enum_string.h"
 
 namespace asval {
@@ -70,88 +70,24 @@ bool ValidateGeometryArrays(const CheckContext& ctx, const BuildCommand& cmd, ui
                      info.pGeometries ? "both non-NULL" : "both NULL", info.geometryCount);
 }
 
-// Totals of the primitives of a bottom-level build, by geometry type (type-03794 / 03795).
-struct PrimitiveTotals {
-  uint64_t triangles = 0;
-  uint64_t aabbs = 0;
-};
-
-bool ValidatePrimitiveTotals(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                             const PrimitiveTotals& totals) {
-  const uint64_t limit = ctx.state.properties.acceleration_structure.maxPrimitiveCount;
-  if (limit == 0) {
-    CountUnknownState(ctx);
-    return false;
-  }
-  bool skip = false;
-  if (totals.aabbs > limit) {
-    skip |= ReportBuild(ctx, cmd, i, InfoVuid("type-03794"), [&](std::string&) { return InfoLocation(cmd, i); },
-                        "is a bottom-level build of {} AABBs in all geometries (the sum of "
-                        "ppBuildRangeInfos[{}][j].primitiveCount), more than "
-                        "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
-                        totals.aabbs, i, limit);
-  }
-  if (totals.triangles > limit) {
-    skip |= ReportBuild(ctx, cmd, i, InfoVuid("type-03795"), [&](std::string&) { return InfoLocation(cmd, i); },
-                        "is a bottom-level build of {} triangles in all geometries (the sum of "
-                        "ppBuildRangeInfos[{}][j].primitiveCount), more than "
-                        "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
-                        totals.triangles, i, limit);
-  }
-  return skip;
-}
-
-[[gnu::cold, gnu::noinline]] bool ReportGeometryType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                                                     uint32_t j, const char* suffix, const char* why) {
-  const VkGeometryTypeKHR type = GeometryAt(cmd.infos[i], j)->geometryType;
-  return ReportBuild(ctx, cmd, i, InfoVuid(suffix),
-                     [&](std::string&) { return GeometryLocation(cmd, i, j).Field("geometryType"); }, "({}) {}",
-                     string_VkGeometryTypeKHR(type), why);
-}
-
 // The geometries of one info: the type rules (type-03789, 03791, 03792), each geometry's data rules, and
-// the primitive totals of a bottom-level build.
+// the primitive totals of a bottom-level build (StructureGeometryRules, build_structure.h).
 bool ValidateGeometries(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (!GeometriesWalkable(ctx, info)) return false;
-  const bool top = info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  const bool bottom = info.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  // Host-side primitive counts exist for direct and host builds; indirect counts live on the device.
-  const VkAccelerationStructureBuildRangeInfoKHR* ranges = cmd.ranges ? cmd.ranges[i] : nullptr;
+  ReportingJudge judge{ctx};
+  GeometryFactsReader facts(ctx.state);
+  StructureGeometryRules<ReportingJudge> rules(ctx, cmd, i);
   bool skip = false;
-  bool type_reported = false;
-  PrimitiveTotals totals;
-  const VkAccelerationStructureGeometryKHR* first = nullptr;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
-    if (!geometry) continue;
-    if (!first) first = geometry;
-    const VkGeometryTypeKHR type = geometry->geometryType;
-    if (!type_reported && top && type != VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03789",
-                                 "is not VK_GEOMETRY_TYPE_INSTANCES_KHR, but the build is top-level.");
-      type_reported = true;
-    } else if (!type_reported && bottom && type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03791",
-                                 "is not allowed in a bottom-level build.");
-      type_reported = true;
-    } else if (!type_reported && bottom && type != first->geometryType) {
-      skip |= ReportGeometryType(ctx, cmd, i, j, "type-03792",
-                                 "differs from the geometryType of the info's first geometry: all geometries of a "
-                                 "bottom-level build must have the same type.");
-      type_reported = true;
-    }
-    skip |= ValidateGeometryData(ctx, cmd, i, j, *geometry);
-    if (bottom && ranges) {
-      if (type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) totals.triangles += ranges[j].primitiveCount;
-      if (type == VK_GEOMETRY_TYPE_AABBS_KHR) totals.aabbs += ranges[j].primitiveCount;
-    }
+    if (geometry) skip |= rules.Geometry(j, facts.Read(*geometry), judge);
   }
-  if (bottom && ranges) skip |= ValidatePrimitiveTotals(ctx, cmd, i, totals);
+  skip |= rules.Finish(judge);
   return skip;
 }
 
-bool ValidateInfoStructure(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+bool ValidateInfoStructure(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
   if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) {
@@ -163,16 +99,41 @@ bool ValidateInfoStructure(const CheckContext& ctx, const BuildCommand& cmd, uin
   skip |= ValidateFlags(ctx, cmd, i);
   skip |= ValidateGeometryArrays(ctx, cmd, i);
   skip |= ValidateGeometryCount(ctx, cmd, i);
-  skip |= ValidateGeometries(ctx, cmd, i);
+  // Geometries in which the command's geometry pass found nothing for this family are not walked again.
+  if (r.walks & kWalkStructure) skip |= ValidateGeometries(ctx, cmd, i);
   return skip;
 }
 
 }  // namespace
 
-bool ValidateBuildStructure(const CheckContext& ctx, const BuildCommand& cmd) {
+bool ReportGeometryType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, const char* suffix,
+                        const char* why) {
+  const VkGeometryTypeKHR type = GeometryAt(cmd.infos[i], j)->geometryType;
+  return ReportBuild(ctx, cmd, i, InfoVuid(suffix),
+                     [&](std::string&) { return GeometryLocation(cmd, i, j).Field("geometryType"); }, "({}) {}",
+                     string_VkGeometryTypeKHR(type), why);
+}
+
+bool ReportPrimitiveTotal(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, bool aabbs, uint64_t total,
+                          uint64_t limit) {
+  if (aabbs) {
+    return ReportBuild(ctx, cmd, i, InfoVuid("type-03794"), [&](std::string&) { return InfoLocation(cmd, i); },
+                       "is a bottom-level build of {} AABBs in all geometries (the sum of "
+                       "ppBuildRangeInfos[{}][j].primitiveCount), more than "
+                       "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
+                       total, i, limit);
+  }
+  return ReportBuild(ctx, cmd, i, InfoVuid("type-03795"), [&](std::string&) { return InfoLocation(cmd, i); },
+                     "is a bottom-level build of {} triangles in all geometries (the sum of "
+                     "ppBuildRangeInfos[{}][j].primitiveCount), more than "
+                     "VkPhysicalDeviceAccelerationStructurePropertiesKHR::maxPrimitiveCount ({}).",
+                     total, i, limit);
+}
+
+bool ValidateBuildStructure(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoStructure(ctx, cmd, i);
+  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoStructure(ctx, cmd, i, resolved.info(i));
   return skip;
 }
 

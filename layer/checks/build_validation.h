@@ -6,6 +6,10 @@
 
 namespace asval {
 
+struct CheckThreadData;
+
 bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd);
+// The same with the calling thread's data, leased by the hook for the whole call (check_thread_data.h).
+bool ValidateBuildCommand(const CheckContext& ctx, const BuildCommand& cmd, CheckThreadData& thread);
 
 }  // namespace asval

@@ -19,11 +19,34 @@
 
 namespace asval {
 
+// The per-geometry walks of the families (ResolvedInfo::walks): the structure family's geometry rules
+// (build_structure.h), its range rules (build_ranges.h), the alignment family's input rules
+// (build_input_alignment.h), the addresses family's input reads (build_input_reads.h) and instance counts
+// (build_sizes.h).
+enum GeometryWalk : uint8_t {
+  kWalkStructure = 1u << 0,
+  kWalkRanges = 1u << 1,
+  kWalkInputAlignment = 1u << 2,
+  kWalkInputReads = 1u << 3,
+  kWalkInstanceCounts = 1u << 4,
+  kWalkAll = (1u << 5) - 1,
+};
+
 struct ResolvedInfo {
+  // User-provided, so that value-initialization (ResolvedInfo(), vector::resize) runs the member initializers
+  // only, without zeroing the whole record first.
+  ResolvedInfo() {}
+
+  // The families that must walk this info's geometries themselves: the geometry pass (geometry_pass.h) found
+  // something to report or count for them, or did not screen this info. The others' rules found nothing.
+  uint8_t walks = kWalkAll;
   // dstAccelerationStructure's record; null when the handle is not a live structure of this device.
-  std::shared_ptr<const AccelerationStructureState> dst;
+  const AccelerationStructureState* dst = nullptr;
   // srcAccelerationStructure's record; null when the handle is VK_NULL_HANDLE or not a live structure.
-  std::shared_ptr<const AccelerationStructureState> src;
+  const AccelerationStructureState* src = nullptr;
+  // Both stay valid for the call: the thread's structure memo holds them, or, when it could not, these do.
+  std::shared_ptr<const AccelerationStructureState> dst_held;
+  std::shared_ptr<const AccelerationStructureState> src_held;
   // The rest is resolved only when the addresses or aliasing family is on (placed = true).
   bool placed = false;
   // The destination's buffer (dst_buffer_known: the layer knows it).
@@ -37,23 +60,28 @@ struct ResolvedInfo {
   KnownBuffer scratch_buffer;
 };
 
-struct ResolvedWorkspace;
+struct CheckThreadData;
 
 // The view of one call. Lives on the hook's stack for the duration of the validation; its per-info records
-// live there too for small calls, else in a per-thread buffer that keeps its capacity, so a steady stream of
-// calls allocates nothing.
+// live there too for small calls, else in the thread's data (check_thread_data.h), which keeps its capacity,
+// so a steady stream of calls allocates nothing.
 class ResolvedBuild {
  public:
-  ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd);
+  // thread: this call's lease of the thread's data (memos, buffers), held for the whole validation.
+  ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, CheckThreadData& thread);
   ~ResolvedBuild();
   ResolvedBuild(const ResolvedBuild&) = delete;
   ResolvedBuild& operator=(const ResolvedBuild&) = delete;
 
   // pInfos[i] resolved (i < cmd.info_count; empty records when cmd.infos is null).
   const ResolvedInfo& info(uint32_t i) const { return infos_[i]; }
+  // The union of the infos' walks: a family whose bit is clear walks no info's geometries at all.
+  uint8_t walks() const { return walks_; }
   // This thread's buffer memo, synced for this call: the families' further lookups (geometry inputs, the
   // source's buffer) go through it. Only when placement was resolved (addresses or aliasing on).
   BufferMemo& memo() const { return *memo_; }
+  // This call's lease of the thread's data (the aliasing sweep's buffers).
+  CheckThreadData& thread() const { return thread_; }
 
  private:
   // Calls of up to this many infos keep their records on the stack (no per-thread lookup, no vector).
@@ -64,8 +92,8 @@ class ResolvedBuild {
     ResolvedInfo infos[kInlineInfos];
   } inline_;
   uint32_t inline_count_ = 0;  // records constructed in inline_
-  ResolvedWorkspace* w_ = nullptr;
-  std::unique_ptr<ResolvedWorkspace> owned_;  // only when the thread's workspace is already in use
+  uint8_t walks_ = kWalkAll;
+  CheckThreadData& thread_;
   ResolvedInfo* infos_ = nullptr;
   BufferMemo* memo_ = nullptr;
 };

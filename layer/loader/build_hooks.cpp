@@ -2,6 +2,7 @@
 // families over it (validate), pass the call down unless the app's callback asked to skip it, then record
 // what it does to the structures' histories (post-record).
 #include "build_validation.h"
+#include "check_thread_data.h"
 #include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
@@ -18,9 +19,11 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.info_count = infoCount;
   cmd.infos = pInfos;
   cmd.ranges = ppBuildRangeInfos;
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
+  const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
-  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuild, infoCount, pInfos, ppBuildRangeInfos);
+  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuild, infoCount, pInfos, ppBuildRangeInfos,
+                 &thread.data().last_recorded);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
@@ -36,11 +39,13 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   cmd.indirect_addresses = pIndirectDeviceAddresses;
   cmd.indirect_strides = pIndirectStrides;
   cmd.max_primitive_counts = ppMaxPrimitiveCounts;
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return;
+  const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);
   // The ranges (and so the primitive counts) are on the device.
-  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuildIndirect, infoCount, pInfos, nullptr);
+  RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuildIndirect, infoCount, pInfos, nullptr,
+                 &thread.data().last_recorded);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(

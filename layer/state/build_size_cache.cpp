@@ -1,5 +1,6 @@
 #include "build_size_cache.h"
 
+#include <algorithm>
 #include <cstring>
 #include <mutex>
 
@@ -7,17 +8,24 @@ namespace asval {
 
 namespace {
 
-// The signature as 64-bit words, written to `out` (room for MaxSignatureWords): hashing, comparing and storing
-// all work on these words, read once from the app's structures. Returns the number of words, or 0 when the
-// build is not cacheable (BuildSignature::Cacheable: an extension chain, a null geometry or a geometry type the
-// layer does not know), as soon as that shows: such a build is never stored, so it is never looked up either
-// and pays no hash.
-std::size_t WriteSignature(const BuildSignature& s, uint64_t* out) {
+// The signature as 64-bit words, handed one by one to `sink(word)` in order: WriteSignature stores them
+// (hashing, comparing and storing all work on these words, read once from the app's structures), and
+// MatchesWords compares them with a stored signature as they are read, without storing or hashing them (sink
+// returns false at the first difference, which ends the walk). Returns the number of words, or 0 when the walk
+// ended early: the build is not cacheable (BuildSignature::Cacheable: an extension chain, a null geometry or a
+// geometry type the layer does not know), which shows as soon as the signature does (such a build is never
+// stored, so it is never looked up either and pays no hash), or the sink refused a word.
+template <typename Sink>
+[[gnu::always_inline]] inline std::size_t EmitSignature(const BuildSignature& s, Sink&& sink) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = *s.info;
   if (info.pNext) return 0;
-  uint64_t* w = out;
-  *w++ = (uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(info.type);
-  *w++ = (uint64_t{info.flags} << 32) | info.geometryCount;
+  std::size_t n = 0;
+  const auto emit = [&](uint64_t word) {
+    ++n;
+    return sink(word);
+  };
+  if (!emit((uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(info.type))) return 0;
+  if (!emit((uint64_t{info.flags} << 32) | info.geometryCount)) return 0;
   // The geometry array and the counts are walked by pointer: Geometry(j) and Count(j) would re-test which
   // array the info uses and multiply the stride for every word.
   const VkAccelerationStructureGeometryKHR* geometries = info.pGeometries;
@@ -27,33 +35,56 @@ std::size_t WriteSignature(const BuildSignature& s, uint64_t* out) {
   for (uint32_t j = 0; j < info.geometryCount; ++j, count += s.count_stride) {
     const VkAccelerationStructureGeometryKHR* g = geometries ? &geometries[j] : geometry_pointers[j];
     if (!g || g->pNext) return 0;
-    *w++ = (uint64_t{static_cast<uint32_t>(g->geometryType)} << 32) | g->flags;
+    if (!emit((uint64_t{static_cast<uint32_t>(g->geometryType)} << 32) | g->flags)) return 0;
     switch (g->geometryType) {
       case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
         const VkAccelerationStructureGeometryTrianglesDataKHR& t = g->geometry.triangles;
         if (t.pNext) return 0;  // motion vertices, micromaps: the sizes depend on them
-        *w++ = (uint64_t{static_cast<uint32_t>(t.vertexFormat)} << 32) | static_cast<uint32_t>(t.indexType);
-        *w++ = t.vertexStride;
-        *w++ = (uint64_t{t.maxVertex} << 1) | (t.transformData.deviceAddress != 0 ? 1u : 0u);
+        if (!emit((uint64_t{static_cast<uint32_t>(t.vertexFormat)} << 32) | static_cast<uint32_t>(t.indexType)) ||
+            !emit(t.vertexStride) ||
+            !emit((uint64_t{t.maxVertex} << 1) | (t.transformData.deviceAddress != 0 ? 1u : 0u))) {
+          return 0;
+        }
         break;
       }
       case VK_GEOMETRY_TYPE_AABBS_KHR:
-        *w++ = g->geometry.aabbs.stride;
+        if (!emit(g->geometry.aabbs.stride)) return 0;
         break;
       case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-        *w++ = g->geometry.instances.arrayOfPointers;
+        if (!emit(g->geometry.instances.arrayOfPointers)) return 0;
         break;
       default:
         return 0;
     }
-    *w++ = uint64_t{*reinterpret_cast<const uint32_t*>(count)};
+    if (!emit(uint64_t{*reinterpret_cast<const uint32_t*>(count)})) return 0;
   }
-  return static_cast<std::size_t>(w - out);
+  return n;
+}
+
+std::size_t WriteSignature(const BuildSignature& s, uint64_t* out) {
+  return EmitSignature(s, [&out](uint64_t word) {
+    *out++ = word;
+    return true;
+  });
 }
 
 // An upper bound of the words WriteSignature writes: two for the info, at most five per geometry (header,
 // three of triangle data, count).
 std::size_t MaxSignatureWords(const BuildSignature& s) { return 2 + std::size_t{5} * s.info->geometryCount; }
+
+// Whether the signature of `s` is exactly the `count` words at `words` (and cacheable). `room`: the words that
+// may be read there, at least MaxSignatureWords(s) (else no match): the walk then accumulates the differences
+// without testing for the end at every word.
+bool MatchesWords(const BuildSignature& s, const uint64_t* words, std::size_t count, std::size_t room) {
+  if (room < MaxSignatureWords(s)) return false;
+  const uint64_t* w = words;
+  uint64_t differences = 0;
+  const std::size_t n = EmitSignature(s, [&w, &differences](uint64_t word) {
+    differences |= *w++ ^ word;
+    return true;
+  });
+  return differences == 0 && n == count;
+}
 
 // Room for one signature: on the stack for infos of up to 102 geometries, else a per-thread buffer that keeps
 // its capacity (it grows, once, on the first call of that length on the thread).
@@ -94,19 +125,10 @@ uint64_t HashOf(const SignatureWords& s) {
   return h;
 }
 
-// The per-thread table: direct-mapped, one signature per slot.
-struct LocalEntry {
-  uint64_t cache_id = 0;  // 0: empty (cache ids start at 1)
-  uint64_t hash = 0;
-  std::size_t count = 0;
-  uint64_t words[BuildSizeCache::kLocalWords];
-  BuildSizes sizes;
-};
-constexpr std::size_t kLocalSlots = 64;
-
-LocalEntry& LocalSlot(uint64_t hash) {
-  thread_local LocalEntry table[kLocalSlots];
-  return table[hash & (kLocalSlots - 1)];
+// The table of callers that keep none of their own (the host family, tests).
+BuildSizeCache::ThreadTable& ThisThreadsTable() {
+  thread_local BuildSizeCache::ThreadTable table;
+  return table;
 }
 
 std::atomic<uint64_t> g_next_cache_id{1};
@@ -123,10 +145,10 @@ bool BuildSignature::Cacheable() const { return SignatureWords(*this).count() !=
 
 BuildSizeCache::BuildSizeCache() : id_(g_next_cache_id.fetch_add(1, std::memory_order_relaxed)) {}
 
-void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count,
+void BuildSizeCache::RememberLocally(ThreadTable& table, uint64_t hash, const uint64_t* words, std::size_t count,
                                      const BuildSizes& sizes) const {
   if (count > kLocalWords) return;
-  LocalEntry& slot = LocalSlot(hash);
+  ThreadTable::Entry& slot = table.SlotFor(hash);
   slot.cache_id = id_;
   slot.hash = hash;
   slot.count = count;
@@ -135,15 +157,46 @@ void BuildSizeCache::RememberLocally(uint64_t hash, const uint64_t* words, std::
 }
 
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) const {
+  return Find(signature, out, ThisThreadsTable());
+}
+
+// The array an info's geometries are read from (the key of ThreadTable::by_arrays).
+const void* GeometryArrayOf(const BuildSignature& s) {
+  return s.info->pGeometries ? static_cast<const void*>(s.info->pGeometries) : s.info->ppGeometries;
+}
+
+void BuildSizeCache::RememberByArrays(ThreadTable& table, const BuildSignature& signature, const uint64_t* words,
+                                      std::size_t count, const BuildSizes& sizes) const {
+  ThreadTable::ByArrays& slot = table.ArraySlotFor(GeometryArrayOf(signature));
+  slot.cache_id = id_;
+  slot.geometries = GeometryArrayOf(signature);
+  slot.counts = signature.counts;
+  // Padded with zeros to MaxSignatureWords, the room MatchesWords reads; allocates only when this slot meets a
+  // longer signature.
+  slot.words.assign(words, words + count);
+  slot.words.resize(std::max(count, MaxSignatureWords(signature)), 0);
+  slot.count = count;
+  slot.sizes = sizes;
+}
+
+bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const {
+  const ThreadTable::ByArrays& by_arrays = table.ArraySlotFor(GeometryArrayOf(signature));
+  if (by_arrays.cache_id == id_ && by_arrays.geometries == GeometryArrayOf(signature) &&
+      by_arrays.counts == signature.counts &&
+      MatchesWords(signature, by_arrays.words.data(), by_arrays.count, by_arrays.words.size())) {
+    *out = by_arrays.sizes;
+    return true;
+  }
   const SignatureWords words(signature);
   if (words.count() == 0) return false;  // never stored
   const uint64_t hash = HashOf(words);
   const bool local = words.count() <= kLocalWords;
   if (local) {
-    const LocalEntry& slot = LocalSlot(hash);
+    const ThreadTable::Entry& slot = table.SlotFor(hash);
     if (slot.cache_id == id_ && slot.hash == hash && slot.count == words.count() &&
         std::memcmp(slot.words, words.data(), words.bytes()) == 0) {
       *out = slot.sizes;
+      RememberByArrays(table, signature, words.data(), words.count(), *out);
       return true;
     }
   }
@@ -158,7 +211,8 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out) cons
     }
     *out = it->second.sizes;
   }
-  if (local) RememberLocally(hash, words.data(), words.count(), *out);
+  if (local) RememberLocally(table, hash, words.data(), words.count(), *out);
+  RememberByArrays(table, signature, words.data(), words.count(), *out);
   return true;
 }
 
@@ -193,7 +247,7 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   entry.sizes = sizes;
   entry.words.assign(words.data(), words.data() + words.count());
   const uint64_t hash = HashOf(words);
-  RememberLocally(hash, entry.words.data(), entry.words.size(), sizes);
+  RememberLocally(ThisThreadsTable(), hash, entry.words.data(), entry.words.size(), sizes);
   Shard& shard = ShardFor(hash);
   std::unique_lock lock(shard.mutex);
   if (shard.map.size() >= kMaxEntriesPerShard) shard.map.clear();

@@ -11,7 +11,9 @@
 //
 // A hit reads the signature once (into a stack buffer, or a per-thread one for infos of more than 102
 // geometries), hashes it and compares a stored copy word by word (so a hash collision can never return
-// another build's sizes): no allocation, no driver call. A build that is not Cacheable is never stored, and a
+// another build's sizes): no allocation, no driver call. A caller that passes its per-thread table first
+// compares the app's structures with the words last found for the same arrays, as it reads them (no copy, no
+// hash); a difference sends it the long way. A build that is not Cacheable is never stored, and a
 // lookup gives up on it as soon as the signature shows it, without hashing. Signatures of up to kLocalWords words (builds of up
 // to two geometries) are first looked up in a small per-thread table, which needs no lock at all; the rest,
 // and per-thread misses, take one shard's shared lock. A miss of both asks the driver through the next
@@ -73,8 +75,44 @@ class BuildSizeCache {
   }
   bool can_query() const { return query_ != nullptr; }
 
+  // Signatures of at most this many words also live in the per-thread table.
+  static constexpr std::size_t kLocalWords = 16;
+
+  // A thread's table of recent hits: direct-mapped, one signature per slot, no lock. A caller that keeps one per
+  // thread (the checks' per-thread data) passes it in; the overload without one uses a thread_local table.
+  struct ThreadTable {
+    struct Entry {
+      uint64_t cache_id = 0;  // 0: empty (cache ids start at 1)
+      uint64_t hash = 0;
+      std::size_t count = 0;
+      uint64_t words[kLocalWords];
+      BuildSizes sizes;
+    };
+    static constexpr std::size_t kSlots = 64;
+    Entry entries[kSlots];
+    Entry& SlotFor(uint64_t hash) { return entries[hash & (kSlots - 1)]; }
+
+    // The signatures last found for an info's geometry and count arrays (a frame records the same builds from
+    // the same arrays call after call). Only a hint of where to look: a lookup compares the app's structures
+    // with the stored words as it reads them (no copy, no hash), and goes the long way at the first difference.
+    struct ByArrays {
+      uint64_t cache_id = 0;  // 0: empty
+      const void* geometries = nullptr;  // pGeometries or ppGeometries
+      const uint32_t* counts = nullptr;
+      std::vector<uint64_t> words;  // the signature, padded with zeros; keeps its capacity
+      std::size_t count = 0;        // words of the signature
+      BuildSizes sizes;
+    };
+    static constexpr std::size_t kArraySlots = 64;
+    ByArrays by_arrays[kArraySlots];
+    ByArrays& ArraySlotFor(const void* geometries) {
+      return by_arrays[(reinterpret_cast<uint64_t>(geometries) * 0x9e3779b97f4a7c15ull) >> 58];
+    }
+  };
+
   // The cached sizes of this build, if it was queried before.
   bool Find(const BuildSignature& signature, BuildSizes* out) const;
+  bool Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const;
 
   // Asks the driver and caches the answer (unless !signature.Cacheable()). The caller must have made sure
   // that the query is valid for this info (the layer's own calls must be valid): features enabled, a
@@ -87,9 +125,6 @@ class BuildSizeCache {
   std::size_t size() const;
   // Forgets every answer (the per-thread tables too). Not concurrent with Find/Query.
   void Clear();
-
-  // Signatures of at most this many words also live in the per-thread table.
-  static constexpr std::size_t kLocalWords = 16;
 
   // A shard holds at most this many signatures; a full shard is emptied (apps whose counts change every
   // frame would otherwise grow the cache without bound).
@@ -108,8 +143,12 @@ class BuildSizeCache {
 
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
+  // Remembers a signature by its arrays in the calling thread's table.
+  void RememberByArrays(ThreadTable& table, const BuildSignature& signature, const uint64_t* words, std::size_t count,
+                        const BuildSizes& sizes) const;
   // Stores a hit in the calling thread's table.
-  void RememberLocally(uint64_t hash, const uint64_t* words, std::size_t count, const BuildSizes& sizes) const;
+  void RememberLocally(ThreadTable& table, uint64_t hash, const uint64_t* words, std::size_t count,
+                       const BuildSizes& sizes) const;
 
   // Names this cache's entries in the per-thread tables; never reused, so an entry of a destroyed device's
   // cache can never answer for another device.

@@ -1,5 +1,6 @@
 #include "command_buffer_ops.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 
@@ -102,7 +103,15 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                            const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
-    AsOp op;
+    const bool has_geometries = info.pGeometries || info.ppGeometries;
+    if (has_geometries) {
+      // Room for the info's geometries at once (growing geometrically, as push_back would: a reserve of the
+      // exact size per info would copy the whole batch on every call). Before the operation is appended, so
+      // that an allocation failure leaves no operation without its geometries.
+      const std::size_t needed = geometries_.size() + info.geometryCount;
+      if (needed > geometries_.capacity()) geometries_.reserve(std::max(needed, 2 * geometries_.capacity()));
+    }
+    AsOp& op = ops_.emplace_back();  // in place: an AsOp is large, and most of it stays at its defaults
     op.kind = OpKind::kBuild;
     op.origin = origin;
     op.origin.element = i;
@@ -114,11 +123,9 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
     op.type = info.type;
     op.geometry_count = info.geometryCount;
     op.first_geometry = static_cast<uint32_t>(geometries_.size());
-    const bool has_geometries = info.pGeometries || info.ppGeometries;
     if (!has_geometries && info.geometryCount != 0) op.geometries_unreadable = true;
     if (has_geometries && info.geometryCount != 0) {
-      // Whether the info has ranges is decided once, not per geometry. (No reserve: one of the exact size per
-      // info would defeat the vector's geometric growth and copy the whole batch on every call.)
+      // Whether the info has ranges is decided once, not per geometry.
       const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges ? ranges[i] : nullptr;
       for (uint32_t j = 0; j < info.geometryCount; ++j) {
         const VkAccelerationStructureGeometryKHR* geometry =
@@ -128,16 +135,14 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
           geometries_.resize(op.first_geometry);
           break;
         }
-        GeometryRecord record = MakeGeometryRecord(*geometry);
+        GeometryRecord& record = geometries_.emplace_back(MakeGeometryRecord(*geometry));
         if (info_ranges) {
           record.primitive_count = info_ranges[j].primitiveCount;
           record.primitive_count_known = true;
         }
-        geometries_.push_back(record);
       }
     }
     if (op.geometries_unreadable || !has_geometries) op.geometry_count = 0;
-    ops_.push_back(op);
   }
 }
 

@@ -89,6 +89,10 @@ struct SerializedLocation {
 };
 
 struct AsOp {
+  // User-provided, so that value-initialization (emplace_back()) runs the member initializers only, without
+  // zeroing the whole operation first.
+  AsOp() {}
+
   OpKind kind = OpKind::kBuild;
   OpOrigin origin;
   VkAccelerationStructureKHR src = VK_NULL_HANDLE;  // build (updates), copy, serialize

@@ -98,6 +98,10 @@ class CommandBufferMap {
   // commands' commandBuffer-09547 is a single load and no map lookup: protected memory is rare.
   bool AnyProtectedPool() const { return any_protected_pool_.load(std::memory_order_acquire); }
   std::size_t size() const { return buffers_.size(); }
+  // Changes to the set of command buffers so far (allocations, frees, pool destruction): while it reads the
+  // same, a CommandBufferState found before is still the one the map holds (history_recorder.cpp keeps the
+  // last one it recorded into).
+  StampValue stamp() const { return buffers_.stamp(); }
 
  private:
   struct PoolState {

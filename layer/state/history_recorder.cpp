@@ -16,6 +16,20 @@ std::shared_ptr<CommandBufferState> Recording(DeviceState& state, VkCommandBuffe
   return state.command_buffers.Find(cb);
 }
 
+// The same for the build commands, the hot path: through the thread's memo of the last command buffer
+// (LastRecordedBuild, history_recorder.h).
+CommandBufferState* RecordingBuild(DeviceState& state, VkCommandBuffer cb, LastRecordedBuild& last) {
+  if (!state.history_tracked) return nullptr;
+  const StampValue stamp = state.command_buffers.stamp();
+  if (last.cb != cb || last.stamp != stamp) last = LastRecordedBuild{stamp, cb, state.command_buffers.Find(cb).get()};
+  return last.state;
+}
+
+LastRecordedBuild& ThisThreadsLastRecordedBuild() {
+  thread_local LastRecordedBuild last;
+  return last;
+}
+
 // Runs an append; an allocation failure leaves the recording marked lost rather than silently incomplete.
 template <typename F>
 void Guarded(CommandBufferState& cb, F&& append) {
@@ -96,8 +110,8 @@ void ApplyNow(DeviceState& state, const OpBatch& batch) {
 
 void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
-  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last) {
+  CommandBufferState* recording = RecordingBuild(state, cb, last ? *last : ThisThreadsLastRecordedBuild());
   if (!recording || !infos) return;
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
   Guarded(*recording, [&] { recording->recording.AppendBuilds(origin, info_count, infos, ranges); });

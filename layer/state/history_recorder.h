@@ -11,10 +11,21 @@
 namespace asval {
 
 // ---- device commands (after the downcall) ----
-// ranges: null for indirect builds (the counts are on the device).
+// The command buffer a thread recorded a build into last, with the command-buffer map's change stamp at that
+// time. While the stamp reads the same, no command buffer was allocated or freed since, so the map still holds
+// that very CommandBufferState; and it stays alive for the call: the app externally synchronizes the command
+// buffer it records into, so it cannot be freed meanwhile. Saves a map lookup and a reference count per build.
+struct LastRecordedBuild {
+  StampValue stamp;  // of the map it came from (ids are never reused: another device's map never matches)
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  CommandBufferState* state = nullptr;  // null: the layer does not know cb
+};
+
+// ranges: null for indirect builds (the counts are on the device). last: the calling thread's memo, kept by the
+// caller with its other per-thread data (null: a thread_local of the recorder's own).
 void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last = nullptr);
 void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info);
 void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
                            const VkCopyAccelerationStructureToMemoryInfoKHR& info);

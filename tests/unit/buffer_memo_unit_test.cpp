@@ -4,6 +4,8 @@
 // shortcut (SameSignatureArrays) may only fire when the signature cannot differ.
 #include <catch2/catch_test_macros.hpp>
 
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "buffer_memo.h"
@@ -127,6 +129,42 @@ TEST_CASE("buffer memo: a command over 40 buffers keeps every one from one comma
     CHECK(found.base == n * 0x10000);
     CHECK(found.memory == Fake<VkDeviceMemory>(100));
   }
+}
+
+TEST_CASE("buffer memo: a hint from an earlier command never answers for another buffer", "[memo]") {
+  DeviceState state;
+  AddBoundBuffer(state, 2, kInput | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  AddBoundBuffer(state, 3, kInput | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  BufferMemo memo;
+  memo.Sync(state);
+  uint8_t hint = 200;  // anything at first
+  KnownBuffer found;
+  REQUIRE(memo.HoldingHinted(state, 0x20000, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, hint, &found));
+  CHECK(found.buffer == Fake<VkBuffer>(2));
+  // The same place now reads buffer 3: the hint (buffer 2's entry) does not serve, the answer is right.
+  REQUIRE(memo.HoldingHinted(state, 0x30000, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, hint, &found));
+  CHECK(found.buffer == Fake<VkBuffer>(3));
+  // Nor for a usage the buffer lacks.
+  CHECK_FALSE(memo.HoldingHinted(state, 0x30000, 64, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, hint, &found));
+
+  // A structure on buffer 3, looked up through a hint that names buffer 2's entry.
+  const std::optional<std::shared_ptr<const BufferState>> three = state.buffers.find(Fake<VkBuffer>(3));
+  REQUIRE(three);
+  AccelerationStructureState structure;
+  structure.buffer = Fake<VkBuffer>(3);
+  structure.buffer_id = (*three)->id;
+  uint8_t dst_hint = 0;
+  REQUIRE(memo.FindOfStructureHinted(state, structure, dst_hint, &found));
+  CHECK(found.buffer == Fake<VkBuffer>(3));
+  REQUIRE(memo.FindOfStructureHinted(state, structure, dst_hint, &found));  // through the hint now
+  CHECK(found.buffer == Fake<VkBuffer>(3));
+
+  // Buffer 3 destroyed and recreated with its handle: the next command's memo is empty, and the structure's
+  // buffer (the old one, by identity) is not found through the stale hint.
+  RecordDestroyBuffer(state, Fake<VkBuffer>(3));
+  AddBoundBuffer(state, 3, kInput);
+  memo.Sync(state);
+  CHECK_FALSE(memo.FindOfStructureHinted(state, structure, dst_hint, &found));
 }
 
 }  // namespace
