@@ -91,8 +91,15 @@ constexpr uint32_t kWrittenInPlaceFrom = 8;
 
 }  // namespace
 
-GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known)
-    : type(geometry.geometryType), flags(geometry.flags), primitive_count(count), primitive_count_known(count_known) {
+GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+  Read(geometry, count, count_known);
+}
+
+void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+  type = geometry.geometryType;
+  flags = geometry.flags;
+  primitive_count = count;
+  primitive_count_known = count_known;
   if (geometry.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     const VkAccelerationStructureGeometryTrianglesDataKHR& t = geometry.geometry.triangles;
     vertex_format = t.vertexFormat;
@@ -104,7 +111,8 @@ GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometr
 }
 
 // Grows the array once and writes the records in place (the capacity was reserved): per geometry, push_back's
-// capacity test and its copy of the record cost more than the record itself.
+// capacity test and its copy of the record cost more than the record itself; only the members a geometry sets
+// are written over the defaults.
 void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& info,
                             const VkAccelerationStructureBuildRangeInfoKHR* info_ranges) {
   const std::size_t first = geometries_.size();
@@ -117,7 +125,7 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
   const std::size_t stride = info_ranges ? sizeof(VkAccelerationStructureBuildRangeInfoKHR) : 0;
   const bool known = info_ranges != nullptr;
   for (uint32_t j = 0; j < info.geometryCount; ++j, count += stride) {
-    out[j] = GeometryRecord(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);
+    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);  // resize wrote the defaults
   }
 }
 

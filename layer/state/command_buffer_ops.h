@@ -56,6 +56,8 @@ struct GeometryRecord {
   // Reads one geometry of a build info; count_known is false for indirect builds. Every member is written
   // once, in place (AppendBuilds emplaces it: no temporary record copied in).
   GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
+  // The same over a record that holds the defaults (a default-constructed one): writes only what the geometry sets.
+  void Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
 
   VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
   VkGeometryFlagsKHR flags = 0;
