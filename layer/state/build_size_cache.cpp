@@ -221,7 +221,7 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, Thre
   const ThreadTable::ByArrays& by_arrays = table.ArraySlotFor(GeometryArrayOf(signature));
   if (by_arrays.cache_id == id_ && by_arrays.geometries == GeometryArrayOf(signature) &&
       by_arrays.counts == signature.counts &&
-      (SameBytesAsLast(by_arrays, signature) ||
+      ((by_arrays.raw && SameBytesAsLast(by_arrays, signature)) ||  // raw: tested here, before the call
        MatchesWords(signature, by_arrays.words.data(), by_arrays.count, by_arrays.words.size()))) {
     *out = by_arrays.sizes;
     return true;
