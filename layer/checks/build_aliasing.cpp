@@ -87,7 +87,8 @@ std::string DescribeSpan(const AccessSpan& s) {
 
 // A structure's bytes this build accesses: `accessed` from its start, at most its size. False when the layer
 // does not know where they are (unknown structure or buffer, not bound).
-bool StructureSpan(const AccelerationStructureState& structure, const KnownBuffer& buffer, VkDeviceSize accessed,
+// Inlined into both callers (the sweep's collection and the one-build path), as it was with one caller.
+[[gnu::always_inline]] inline bool StructureSpan(const AccelerationStructureState& structure, const KnownBuffer& buffer, VkDeviceSize accessed,
                    uint32_t info, SpanKind kind, AccessSpan* out) {
   if (!buffer.bound || buffer.memory == VK_NULL_HANDLE) return false;
   const VkDeviceSize begin = SaturatingAdd(buffer.memory_offset, structure.offset);
@@ -112,7 +113,7 @@ bool StructureSpan(const DeviceState& state, BufferMemo& memo, VkAccelerationStr
   return structure && StructureSpan(state, memo, structure->get(), accessed, info, kind, out);
 }
 
-bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
+[[gnu::always_inline]] inline bool ScratchSpan(const DeviceState& state, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                  BufferMemo& memo, AccessSpan* out) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (cmd.is_host()) {
@@ -336,13 +337,45 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
   return skip;
 }
 
+Workspace& ClearedWorkspace(CheckThreadData& thread) {
+  if (!thread.aliasing) thread.aliasing = std::make_unique<AliasingWorkspace>();
+  thread.aliasing->spans.clear();
+  return *thread.aliasing;
+}
+
 }  // namespace
 
-AliasingSweep::AliasingSweep(CheckThreadData& thread) {
-  if (!thread.aliasing) thread.aliasing = std::make_unique<AliasingWorkspace>();
-  w_ = thread.aliasing.get();
-  w_->spans.clear();
+bool IsOneBuildAliasing(const BuildCommand& cmd) {
+  if (cmd.info_count != 1 || cmd.is_host()) return false;
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[0];
+  return info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE;
 }
+
+// CollectSpans for pInfos[0] without a source span (pInfos-03668 needs one too: nothing to check), then the
+// sweep only when the two spans may overlap: CertainlyDisjoint's pairwise test on two spans, the same one.
+bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
+                              CheckThreadData& thread) {
+  if (!r.sizes) return false;  // counted by ValidateBuildMemory
+  AccessSpan dst, scratch;
+  const bool has_dst =
+      r.dst && r.dst_buffer_known &&
+      StructureSpan(*r.dst, r.dst_buffer, r.sizes->acceleration_structure_size, 0, SpanKind::kDst, &dst);
+  if (!has_dst) CountUnknownState(ctx);
+  bool has_scratch = false;
+  if (r.scratch_bytes != 0) {
+    has_scratch = ScratchSpan(ctx.state, cmd, 0, r, memo, &scratch);
+    if (!has_scratch) CountUnknownState(ctx);
+  }
+  if (!has_dst || !has_scratch || !SameSpace(dst, scratch) || !(dst.begin < scratch.end && scratch.begin < dst.end)) {
+    return false;
+  }
+  Workspace& w = ClearedWorkspace(thread);
+  w.spans.push_back(dst);
+  w.spans.push_back(scratch);
+  return SweepOverlaps(ctx, cmd, w);
+}
+
+AliasingSweep::AliasingSweep(CheckThreadData& thread) : w_(&ClearedWorkspace(thread)) {}
 
 bool AliasingSweep::AddInfo(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                             BufferMemo& memo) {

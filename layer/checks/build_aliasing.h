@@ -69,4 +69,12 @@ class AliasingSweep {
   AliasingWorkspace* w_;
 };
 
+// Whether the command is one device build whose info is no update from another source: only its destination and
+// its scratch can overlap then (dstAccelerationStructure-03703), and ValidateOneBuildAliasing judges it.
+bool IsOneBuildAliasing(const BuildCommand& cmd);
+// The aliasing rules for such a command, instead of an AliasingSweep: the same findings and unknown-state counts,
+// without collecting the spans unless the two may overlap (then the sweep judges them, as it always did).
+bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
+                              CheckThreadData& thread);
+
 }  // namespace asval

@@ -12,9 +12,15 @@ bool ValidateBuildMemory(const CheckContext& ctx, const BuildCommand& cmd, const
   if (!cmd.infos) return false;
   const bool addresses = ctx.Enabled(kCheckAddresses);
   const bool aliasing = ctx.Enabled(kCheckAliasing);
+  bool skip = false;
+  if (aliasing && IsOneBuildAliasing(cmd)) {  // the common single build: no sweep to set up
+    const ResolvedInfo& r = resolved.info(0);
+    if (!r.sizes) CountUnknownState(ctx);  // the sizes of this build cannot be known
+    if (addresses) skip |= ValidateInfoAddresses(ctx, cmd, 0, r, resolved.memo());
+    return skip | ValidateOneBuildAliasing(ctx, cmd, r, resolved.memo(), resolved.thread());
+  }
   std::optional<AliasingSweep> sweep;
   if (aliasing) sweep.emplace(resolved.thread());
-  bool skip = false;
   for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const ResolvedInfo& r = resolved.info(i);
     if (!r.sizes) CountUnknownState(ctx);  // the sizes of this build cannot be known

@@ -86,6 +86,37 @@ bool MatchesWords(const BuildSignature& s, const uint64_t* words, std::size_t co
   return differences == 0 && n == count;
 }
 
+// The signature's first two words, which come from the info alone (EmitSignature writes them first).
+uint64_t InfoWord0(const BuildSignature& s) {
+  return (uint64_t{static_cast<uint32_t>(s.build_type)} << 32) | static_cast<uint32_t>(s.info->type);
+}
+uint64_t InfoWord1(const BuildSignature& s) { return (uint64_t{s.info->flags} << 32) | s.info->geometryCount; }
+
+// Whether `s` reads exactly the bytes `slot` last read its signature from (ByArrays::raw): the info's words
+// (build type, structure type, flags, geometry count), no info pNext, the geometry structs byte for byte and
+// the counts. Then its signature is the slot's (a cacheable one: only such signatures are stored).
+constexpr uint32_t kRawCompareFrom = 4;
+bool SameBytesAsLast(const BuildSizeCache::ThreadTable::ByArrays& slot, const BuildSignature& s) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = *s.info;
+  // A few geometries are compared faster word by word (MatchesWords) than through memcmp's call and setup.
+  if (!slot.raw || info.pNext || !info.pGeometries || info.geometryCount < kRawCompareFrom || slot.count < 2) {
+    return false;
+  }
+  if (slot.words[0] != InfoWord0(s) || slot.words[1] != InfoWord1(s)) return false;
+  const uint32_t n = info.geometryCount;
+  if (slot.raw_geometries.size() != n || slot.raw_counts.size() != n) return false;
+  if (n == 0) return true;
+  if (std::memcmp(info.pGeometries, slot.raw_geometries.data(), n * sizeof(VkAccelerationStructureGeometryKHR)) != 0) {
+    return false;
+  }
+  uint32_t differences = 0;
+  const char* count = reinterpret_cast<const char*>(s.counts);
+  for (uint32_t j = 0; j < n; ++j, count += s.count_stride) {
+    differences |= slot.raw_counts[j] ^ *reinterpret_cast<const uint32_t*>(count);
+  }
+  return differences == 0;
+}
+
 // Room for one signature: on the stack for infos of up to 102 geometries, else a per-thread buffer that keeps
 // its capacity (it grows, once, on the first call of that length on the thread).
 class SignatureWords {
@@ -177,13 +208,21 @@ void BuildSizeCache::RememberByArrays(ThreadTable& table, const BuildSignature& 
   slot.words.resize(std::max(count, MaxSignatureWords(signature)), 0);
   slot.count = count;
   slot.sizes = sizes;
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = *signature.info;
+  slot.raw = info.pGeometries != nullptr && info.pNext == nullptr && info.geometryCount >= kRawCompareFrom;
+  if (slot.raw) {
+    slot.raw_geometries.assign(info.pGeometries, info.pGeometries + info.geometryCount);
+    slot.raw_counts.resize(info.geometryCount);
+    for (uint32_t j = 0; j < info.geometryCount; ++j) slot.raw_counts[j] = signature.Count(j);
+  }
 }
 
 bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const {
   const ThreadTable::ByArrays& by_arrays = table.ArraySlotFor(GeometryArrayOf(signature));
   if (by_arrays.cache_id == id_ && by_arrays.geometries == GeometryArrayOf(signature) &&
       by_arrays.counts == signature.counts &&
-      MatchesWords(signature, by_arrays.words.data(), by_arrays.count, by_arrays.words.size())) {
+      ((by_arrays.raw && SameBytesAsLast(by_arrays, signature)) ||  // raw: tested here, before the call
+       MatchesWords(signature, by_arrays.words.data(), by_arrays.count, by_arrays.words.size()))) {
     *out = by_arrays.sizes;
     return true;
   }

@@ -102,6 +102,14 @@ class BuildSizeCache {
       std::vector<uint64_t> words;  // the signature, padded with zeros; keeps its capacity
       std::size_t count = 0;        // words of the signature
       BuildSizes sizes;
+      // The bytes the signature was read from, when the info used pGeometries: its geometry structs as they
+      // were, and the counts. An app that records the same arrays unchanged (a frame's builds) is recognized
+      // by one memcmp of the structs and a compare of the counts, instead of reading every field the signature
+      // takes: equal bytes (with the info's own words equal) give an equal signature, so the answer is the one
+      // the word compare would give. Any difference (an address moved) only sends it to the word compare.
+      bool raw = false;
+      std::vector<VkAccelerationStructureGeometryKHR> raw_geometries;  // keeps its capacity
+      std::vector<uint32_t> raw_counts;
     };
     static constexpr std::size_t kArraySlots = 64;
     ByArrays by_arrays[kArraySlots];

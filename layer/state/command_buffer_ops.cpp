@@ -83,19 +83,50 @@ void OpBatch::Clear() {
   geometries_.clear();
 }
 
-GeometryRecord MakeGeometryRecord(const VkAccelerationStructureGeometryKHR& geometry) {
-  GeometryRecord record;
-  record.type = geometry.geometryType;
-  record.flags = geometry.flags;
+namespace {
+
+// Infos of at least this many geometries (from pGeometries) are appended by AppendInPlace; fewer one by one,
+// which costs less than the out-of-line resize for one or two.
+constexpr uint32_t kWrittenInPlaceFrom = 8;
+
+}  // namespace
+
+GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+  Read(geometry, count, count_known);
+}
+
+void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+  type = geometry.geometryType;
+  flags = geometry.flags;
+  primitive_count = count;
+  primitive_count_known = count_known;
   if (geometry.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     const VkAccelerationStructureGeometryTrianglesDataKHR& t = geometry.geometry.triangles;
-    record.vertex_format = t.vertexFormat;
-    record.index_type = t.indexType;
-    record.max_vertex = t.maxVertex;
+    vertex_format = t.vertexFormat;
+    index_type = t.indexType;
+    max_vertex = t.maxVertex;
     // The union's device and host members share storage: non-null either way reads as a non-zero address.
-    record.has_transform = t.transformData.deviceAddress != 0;
+    has_transform = t.transformData.deviceAddress != 0;
   }
-  return record;
+}
+
+// Grows the array once and writes the records in place (the capacity was reserved): per geometry, push_back's
+// capacity test and its copy of the record cost more than the record itself; only the members a geometry sets
+// are written over the defaults.
+void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                            const VkAccelerationStructureBuildRangeInfoKHR* info_ranges) {
+  const std::size_t first = geometries_.size();
+  geometries_.resize(first + info.geometryCount);
+  GeometryRecord* out = geometries_.data() + first;
+  // Without ranges every count reads the same zero (stride 0): the loop does not branch on it.
+  static constexpr uint32_t kNoCount = 0;
+  const char* count = info_ranges ? reinterpret_cast<const char*>(&info_ranges[0].primitiveCount)
+                                  : reinterpret_cast<const char*>(&kNoCount);
+  const std::size_t stride = info_ranges ? sizeof(VkAccelerationStructureBuildRangeInfoKHR) : 0;
+  const bool known = info_ranges != nullptr;
+  for (uint32_t j = 0; j < info.geometryCount; ++j, count += stride) {
+    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);  // resize wrote the defaults
+  }
 }
 
 void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
@@ -127,18 +158,22 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
     if (has_geometries && info.geometryCount != 0) {
       // Whether the info has ranges is decided once, not per geometry.
       const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges ? ranges[i] : nullptr;
-      for (uint32_t j = 0; j < info.geometryCount; ++j) {
-        const VkAccelerationStructureGeometryKHR* geometry =
-            info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-        if (!geometry) {  // every check family guards this; the record must too
-          op.geometries_unreadable = true;
-          geometries_.resize(op.first_geometry);
-          break;
-        }
-        GeometryRecord& record = geometries_.emplace_back(MakeGeometryRecord(*geometry));
-        if (info_ranges) {
-          record.primitive_count = info_ranges[j].primitiveCount;
-          record.primitive_count_known = true;
+      if (info.pGeometries && info.geometryCount >= kWrittenInPlaceFrom) {
+        AppendInPlace(info, info_ranges);
+      } else {
+        for (uint32_t j = 0; j < info.geometryCount; ++j) {
+          const VkAccelerationStructureGeometryKHR* geometry =
+              info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+          if (!geometry) {  // every check family guards this; the record must too
+            op.geometries_unreadable = true;
+            geometries_.resize(op.first_geometry);
+            break;
+          }
+          GeometryRecord& record = geometries_.emplace_back(GeometryRecord(*geometry, 0, false));
+          if (info_ranges) {
+            record.primitive_count = info_ranges[j].primitiveCount;
+            record.primitive_count_known = true;
+          }
         }
       }
     }

@@ -52,6 +52,13 @@ std::string DescribeOrigin(const OpOrigin& origin);
 
 // One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769).
 struct GeometryRecord {
+  GeometryRecord() = default;
+  // Reads one geometry of a build info; count_known is false for indirect builds. Every member is written
+  // once, in place (AppendBuilds emplaces it: no temporary record copied in).
+  GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
+  // The same over a record that holds the defaults (a default-constructed one): writes only what the geometry sets.
+  void Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
+
   VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
   VkGeometryFlagsKHR flags = 0;
   VkFormat vertex_format = VK_FORMAT_UNDEFINED;  // triangles only
@@ -145,11 +152,13 @@ class OpBatch {
   void AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary);
 
  private:
+  // The geometries of one info from pGeometries, appended at once (capacity reserved by the caller).
+  void AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                     const VkAccelerationStructureBuildRangeInfoKHR* info_ranges);
+
   std::vector<AsOp> ops_;
   std::vector<GeometryRecord> geometries_;
 };
 
-// Reads one geometry of a build info into its record; primitive_count is set by the caller.
-GeometryRecord MakeGeometryRecord(const VkAccelerationStructureGeometryKHR& geometry);
 
 }  // namespace asval

@@ -57,6 +57,44 @@ TEST_CASE("size cache: a build of 256 geometries is found, and a change in its l
   CHECK(f.state.build_sizes.queries() == 1);
 }
 
+TEST_CASE("size cache: an array seen last time is compared byte for byte, and any change is still seen",
+          "[sizes][cache]") {
+  // From 4 geometries, the arrays' slot compares the geometry structs and counts raw (memcmp) first; a raw
+  // difference goes to the word compare, so only what the signature holds may change the answer.
+  BuildStateFixture f;
+  std::vector<VkAccelerationStructureGeometryKHR> geometries(8, TriangleGeometry(0x1000));
+  VkAccelerationStructureBuildGeometryInfoKHR info = OneGeometryInfo(kBottom, geometries.data());
+  info.geometryCount = 8;
+  std::vector<uint32_t> counts(8, 2);
+  BuildSizes sizes;
+  REQUIRE(f.state.build_sizes.Query(Signature(info, counts)));
+  REQUIRE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  REQUIRE(f.state.build_sizes.Find(Signature(info, counts), &sizes));  // the raw compare answers
+  geometries[3].geometry.triangles.vertexData.deviceAddress = 0x9000;  // not in the signature: still found
+  CHECK(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  geometries[5].geometry.triangles.maxVertex += 1;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  geometries[5].geometry.triangles.maxVertex -= 1;
+  CHECK(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  counts[6] = 3;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  counts[6] = 2;
+  const VkAccelerationStructureGeometryMotionTrianglesDataNV motion{
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_MOTION_TRIANGLES_DATA_NV};
+  geometries[7].geometry.triangles.pNext = &motion;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  geometries[7].geometry.triangles.pNext = nullptr;
+  info.flags |= VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  info.flags = OneGeometryInfo(kBottom, geometries.data()).flags;
+  info.geometryCount = 7;
+  CHECK_FALSE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  info.geometryCount = 8;
+  REQUIRE(f.state.build_sizes.Find(Signature(info, counts), &sizes));
+  CHECK(sizes.acceleration_structure_size == FakeSizes::Structure(16));
+  CHECK(f.state.build_sizes.queries() == 1);
+}
+
 TEST_CASE("size cache: counts, formats, flags and geometry counts are part of the signature", "[sizes][cache]") {
   BuildStateFixture f;
   VkAccelerationStructureGeometryKHR g = TriangleGeometry(0x1000);
