@@ -87,6 +87,13 @@ void AllocateCommandBuffers(DeviceState& state, VkCommandPool pool, uint32_t cou
       cbs);
 }
 
+// Records `build` alone into cb, as a complete recording: begin, the build, end.
+void RecordAlone(DeviceState& state, VkCommandBuffer cb, const Build& build) {
+  state.command_buffers.Reset(cb);
+  RecordCmdBuild(state, cb, OpCommand::kCmdBuild, 1, &build.info, &build.range_pointer);
+  state.command_buffers.End(cb);
+}
+
 constexpr VkBuildAccelerationStructureFlagsKHR kUpdatable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
 
 OpOrigin Origin(OpCommand command) {
@@ -394,7 +401,6 @@ TEST_CASE("history unit: a submission on another queue waits for a rejected one,
           "[history][threads]") {
   World w;
   Reporter reporter(ReportSettings{});
-  CommandBufferMap& map = w.state.command_buffers;
   const VkCommandPool pool = Fake<VkCommandPool>(3);
   const VkCommandBuffer rebuild = Fake<VkCommandBuffer>(100), update = Fake<VkCommandBuffer>(101);
   const VkCommandBuffer both[] = {rebuild, update};
@@ -403,12 +409,8 @@ TEST_CASE("history unit: a submission on another queue waits for a rejected one,
   // queue 2, meanwhile, updates it with one geometry: valid, because the rebuild never happened.
   const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), update_one(w.a, {1}, kUpdatable, w.a);
   CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&one})).empty());
-  map.Reset(rebuild);
-  RecordCmdBuild(w.state, rebuild, OpCommand::kCmdBuild, 1, &two.info, &two.range_pointer);
-  map.End(rebuild);
-  map.Reset(update);
-  RecordCmdBuild(w.state, update, OpCommand::kCmdBuild, 1, &update_one.info, &update_one.range_pointer);
-  map.End(update);
+  RecordAlone(w.state, rebuild, two);
+  RecordAlone(w.state, update, update_one);
 
   std::atomic<bool> in_downcall{false};
   bool second_reported = true;
@@ -544,9 +546,7 @@ TEST_CASE("history unit: a primary takes a secondary's last completed recording,
   const VkCommandBuffer both[] = {primary, secondary};
   AllocateCommandBuffers(w.state, pool, 2, both);
   const Build of_a(w.a, {1}, kUpdatable), of_b(w.b, {1}, kUpdatable);
-  map.Reset(secondary);
-  RecordCmdBuild(w.state, secondary, OpCommand::kCmdBuild, 1, &of_a.info, &of_a.range_pointer);
-  map.End(secondary);
+  RecordAlone(w.state, secondary, of_a);
   // Another thread begins re-recording the secondary while this one executes it (pCommandBuffers of
   // vkCmdExecuteCommands is not externally synchronized): the primary must not read the half-made recording.
   map.Reset(secondary);
