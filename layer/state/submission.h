@@ -13,6 +13,11 @@
 // changes that are then undone. Submissions are rare next to recorded commands, and one order gives every
 // submission a single total order, which is the order the layer assumes the device executes them in (host
 // submission order; see docs/history.md).
+//
+// The order lock is recursive, so an app callback that reports a finding of this submission may itself submit on
+// this thread. A callback that instead waits for another thread which submits on this device would wait forever
+// (that thread waits for the order lock): an unusual callback, and the price of never checking one submission
+// against another's changes that are then undone.
 #include <vulkan/vulkan.h>
 
 #include <mutex>
