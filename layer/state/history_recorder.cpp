@@ -74,28 +74,14 @@ SerializedLocation ResolveDeviceLocation(const DeviceState& state, VkDeviceAddre
   return where;
 }
 
-AsOp CopyOp(const VkCopyAccelerationStructureInfoKHR& info) {
+// A copy (kCopy), serialization (kSerialize: no dst) or deserialization (kDeserialize: no src).
+AsOp CopyKindOp(OpKind kind, VkAccelerationStructureKHR src, VkAccelerationStructureKHR dst,
+                VkCopyAccelerationStructureModeKHR mode) {
   AsOp op;
-  op.kind = OpKind::kCopy;
-  op.src = info.src;
-  op.dst = info.dst;
-  op.copy_mode = info.mode;
-  return op;
-}
-
-AsOp SerializeOp(const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
-  AsOp op;
-  op.kind = OpKind::kSerialize;
-  op.src = info.src;
-  op.copy_mode = info.mode;
-  return op;
-}
-
-AsOp DeserializeOp(const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
-  AsOp op;
-  op.kind = OpKind::kDeserialize;
-  op.dst = info.dst;
-  op.copy_mode = info.mode;
+  op.kind = kind;
+  op.src = src;
+  op.dst = dst;
+  op.copy_mode = mode;
   return op;
 }
 
@@ -120,7 +106,7 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
 void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
-  AsOp op = CopyOp(info);
+  AsOp op = CopyKindOp(OpKind::kCopy, info.src, info.dst, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopy, cb);
   Guarded(*recording, [&] { recording->recording.Append(op); });
 }
@@ -129,7 +115,7 @@ void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
                            const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
-  AsOp op = SerializeOp(info);
+  AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyToMemory, cb);
   op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);
   Guarded(*recording, [&] { recording->recording.Append(op); });
@@ -139,7 +125,7 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
                            const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
-  AsOp op = DeserializeOp(info);
+  AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyMemoryTo, cb);
   op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);
   Guarded(*recording, [&] { recording->recording.Append(op); });
@@ -196,7 +182,7 @@ OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeom
 
 OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info) {
   OpBatch batch;
-  AsOp op = CopyOp(info);
+  AsOp op = CopyKindOp(OpKind::kCopy, info.src, info.dst, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopy);
   batch.Append(op);
   return batch;
@@ -204,7 +190,7 @@ OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info) {
 
 OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
   OpBatch batch;
-  AsOp op = SerializeOp(info);
+  AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopyToMemory);
   op.memory.host_address = info.dst.hostAddress;
   batch.Append(op);
@@ -213,7 +199,7 @@ OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& in
 
 OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
   OpBatch batch;
-  AsOp op = DeserializeOp(info);
+  AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopyMemoryTo);
   op.memory.host_address = info.src.hostAddress;
   batch.Append(op);
