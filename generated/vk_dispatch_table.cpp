@@ -59,6 +59,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(gdpa(device, "vkCreateAccelerationStructureKHR"));
   table->CreateBuffer = reinterpret_cast<PFN_vkCreateBuffer>(gdpa(device, "vkCreateBuffer"));
   table->CreateCommandPool = reinterpret_cast<PFN_vkCreateCommandPool>(gdpa(device, "vkCreateCommandPool"));
+  table->CreateFence = reinterpret_cast<PFN_vkCreateFence>(gdpa(device, "vkCreateFence"));
   table->CreateQueryPool = reinterpret_cast<PFN_vkCreateQueryPool>(gdpa(device, "vkCreateQueryPool"));
   table->DeferredOperationJoinKHR = reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(gdpa(device, "vkDeferredOperationJoinKHR"));
   table->DestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(gdpa(device, "vkDestroyAccelerationStructureKHR"));
@@ -66,6 +67,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->DestroyCommandPool = reinterpret_cast<PFN_vkDestroyCommandPool>(gdpa(device, "vkDestroyCommandPool"));
   table->DestroyDeferredOperationKHR = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(gdpa(device, "vkDestroyDeferredOperationKHR"));
   table->DestroyDevice = reinterpret_cast<PFN_vkDestroyDevice>(gdpa(device, "vkDestroyDevice"));
+  table->DestroyFence = reinterpret_cast<PFN_vkDestroyFence>(gdpa(device, "vkDestroyFence"));
   table->DestroyQueryPool = reinterpret_cast<PFN_vkDestroyQueryPool>(gdpa(device, "vkDestroyQueryPool"));
   table->DeviceWaitIdle = reinterpret_cast<PFN_vkDeviceWaitIdle>(gdpa(device, "vkDeviceWaitIdle"));
   table->EndCommandBuffer = reinterpret_cast<PFN_vkEndCommandBuffer>(gdpa(device, "vkEndCommandBuffer"));
@@ -82,6 +84,8 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->GetDeviceQueue2 = reinterpret_cast<PFN_vkGetDeviceQueue2>(gdpa(device, "vkGetDeviceQueue2"));
   table->GetFenceStatus = reinterpret_cast<PFN_vkGetFenceStatus>(gdpa(device, "vkGetFenceStatus"));
   table->GetQueryPoolResults = reinterpret_cast<PFN_vkGetQueryPoolResults>(gdpa(device, "vkGetQueryPoolResults"));
+  static constexpr const char* kGetSemaphoreCounterValueNames[] = {"vkGetSemaphoreCounterValue", "vkGetSemaphoreCounterValueKHR"};
+  table->GetSemaphoreCounterValue = reinterpret_cast<PFN_vkGetSemaphoreCounterValue>(LoadFirst(gdpa, device, kGetSemaphoreCounterValueNames));
   table->MapMemory = reinterpret_cast<PFN_vkMapMemory>(gdpa(device, "vkMapMemory"));
   table->QueueSubmit = reinterpret_cast<PFN_vkQueueSubmit>(gdpa(device, "vkQueueSubmit"));
   static constexpr const char* kQueueSubmit2Names[] = {"vkQueueSubmit2", "vkQueueSubmit2KHR"};
@@ -89,9 +93,12 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->QueueWaitIdle = reinterpret_cast<PFN_vkQueueWaitIdle>(gdpa(device, "vkQueueWaitIdle"));
   table->ResetCommandBuffer = reinterpret_cast<PFN_vkResetCommandBuffer>(gdpa(device, "vkResetCommandBuffer"));
   table->ResetCommandPool = reinterpret_cast<PFN_vkResetCommandPool>(gdpa(device, "vkResetCommandPool"));
+  table->ResetFences = reinterpret_cast<PFN_vkResetFences>(gdpa(device, "vkResetFences"));
   table->SetDebugUtilsObjectNameEXT = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(gdpa(device, "vkSetDebugUtilsObjectNameEXT"));
   table->UnmapMemory = reinterpret_cast<PFN_vkUnmapMemory>(gdpa(device, "vkUnmapMemory"));
   table->WaitForFences = reinterpret_cast<PFN_vkWaitForFences>(gdpa(device, "vkWaitForFences"));
+  static constexpr const char* kWaitSemaphoresNames[] = {"vkWaitSemaphores", "vkWaitSemaphoresKHR"};
+  table->WaitSemaphores = reinterpret_cast<PFN_vkWaitSemaphores>(LoadFirst(gdpa, device, kWaitSemaphoresNames));
   table->WriteAccelerationStructuresPropertiesKHR = reinterpret_cast<PFN_vkWriteAccelerationStructuresPropertiesKHR>(gdpa(device, "vkWriteAccelerationStructuresPropertiesKHR"));
 }
 

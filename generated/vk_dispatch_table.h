@@ -46,6 +46,7 @@ struct DeviceDispatchTable {
   PFN_vkCreateAccelerationStructureKHR CreateAccelerationStructureKHR = nullptr;
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
+  PFN_vkCreateFence CreateFence = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
   PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
   PFN_vkDestroyAccelerationStructureKHR DestroyAccelerationStructureKHR = nullptr;
@@ -53,6 +54,7 @@ struct DeviceDispatchTable {
   PFN_vkDestroyCommandPool DestroyCommandPool = nullptr;
   PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
   PFN_vkDestroyDevice DestroyDevice = nullptr;
+  PFN_vkDestroyFence DestroyFence = nullptr;
   PFN_vkDestroyQueryPool DestroyQueryPool = nullptr;
   PFN_vkDeviceWaitIdle DeviceWaitIdle = nullptr;
   PFN_vkEndCommandBuffer EndCommandBuffer = nullptr;
@@ -68,15 +70,18 @@ struct DeviceDispatchTable {
   PFN_vkGetDeviceQueue2 GetDeviceQueue2 = nullptr;
   PFN_vkGetFenceStatus GetFenceStatus = nullptr;
   PFN_vkGetQueryPoolResults GetQueryPoolResults = nullptr;
+  PFN_vkGetSemaphoreCounterValue GetSemaphoreCounterValue = nullptr;
   PFN_vkMapMemory MapMemory = nullptr;
   PFN_vkQueueSubmit QueueSubmit = nullptr;
   PFN_vkQueueSubmit2 QueueSubmit2 = nullptr;
   PFN_vkQueueWaitIdle QueueWaitIdle = nullptr;
   PFN_vkResetCommandBuffer ResetCommandBuffer = nullptr;
   PFN_vkResetCommandPool ResetCommandPool = nullptr;
+  PFN_vkResetFences ResetFences = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT SetDebugUtilsObjectNameEXT = nullptr;
   PFN_vkUnmapMemory UnmapMemory = nullptr;
   PFN_vkWaitForFences WaitForFences = nullptr;
+  PFN_vkWaitSemaphores WaitSemaphores = nullptr;
   PFN_vkWriteAccelerationStructuresPropertiesKHR WriteAccelerationStructuresPropertiesKHR = nullptr;
 };
 

@@ -39,19 +39,27 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyDevice",
     "vkDestroyInstance",
     "vkDestroyQueryPool",
+    "vkDeviceWaitIdle",
     "vkEndCommandBuffer",
     "vkFreeCommandBuffers",
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
+    "vkGetFenceStatus",
     "vkGetQueryPoolResults",
+    "vkGetSemaphoreCounterValue",
+    "vkGetSemaphoreCounterValueKHR",
     "vkMapMemory",
     "vkQueueSubmit",
     "vkQueueSubmit2",
     "vkQueueSubmit2KHR",
+    "vkQueueWaitIdle",
     "vkResetCommandBuffer",
     "vkResetCommandPool",
     "vkSetDebugUtilsObjectNameEXT",
     "vkUnmapMemory",
+    "vkWaitForFences",
+    "vkWaitSemaphores",
+    "vkWaitSemaphoresKHR",
     "vkWriteAccelerationStructuresPropertiesKHR",
 };
 
@@ -89,19 +97,27 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkDestroyDevice
     false,  // vkDestroyInstance
     true,  // vkDestroyQueryPool
+    true,  // vkDeviceWaitIdle
     true,  // vkEndCommandBuffer
     true,  // vkFreeCommandBuffers
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR
+    true,  // vkGetFenceStatus
     true,  // vkGetQueryPoolResults
+    true,  // vkGetSemaphoreCounterValue
+    true,  // vkGetSemaphoreCounterValueKHR
     true,  // vkMapMemory
     true,  // vkQueueSubmit
     true,  // vkQueueSubmit2
     true,  // vkQueueSubmit2KHR
+    true,  // vkQueueWaitIdle
     true,  // vkResetCommandBuffer
     true,  // vkResetCommandPool
     true,  // vkSetDebugUtilsObjectNameEXT
     true,  // vkUnmapMemory
+    true,  // vkWaitForFences
+    true,  // vkWaitSemaphores
+    true,  // vkWaitSemaphoresKHR
     true,  // vkWriteAccelerationStructuresPropertiesKHR
 };
 

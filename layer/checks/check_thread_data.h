@@ -30,6 +30,7 @@ struct CheckThreadData {
   std::vector<ResolvedInfo> infos;  // the per-info records of calls of more infos than ResolvedBuild keeps inline
   std::unique_ptr<AliasingWorkspace> aliasing;  // made on the thread's first sweep
   LastRecordedBuild last_recorded;  // RecordCmdBuild's memo
+  std::vector<uint32_t> captured_infos;  // the capture's per-info answer for the call (build_hooks.cpp)
   // Per info index (the first kHintedInfos), the buffer-memo entries that answered its scratch and its
   // destination's buffer last call (BufferMemo::HoldingHinted, FindOfStructureHinted): a frame records the same
   // builds call after call.

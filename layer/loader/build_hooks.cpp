@@ -9,6 +9,28 @@
 
 namespace asval::hooks {
 
+namespace {
+
+// Pre-record: the copies of what the infos that need it read, recorded before the build (layer/capture). Returns
+// per info its capture index plus one (0: none), or null when the call captures nothing: the common static
+// build costs one flag test per info.
+const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t info_count,
+                                 const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                                 const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                                 std::vector<uint32_t>& captured) {
+  if (!data.capture_tracker || !infos) return nullptr;
+  bool any = false;
+  for (uint32_t i = 0; i < info_count && !any; ++i) any = NeedsCapture(data.capture_mode, infos[i]);
+  if (!any) return nullptr;
+  const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
+  if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown
+  return CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured)
+             ? captured.data()
+             : nullptr;
+}
+
+}  // namespace
+
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
     VkCommandBuffer commandBuffer, uint32_t infoCount, const VkAccelerationStructureBuildGeometryInfoKHR* pInfos,
     const VkAccelerationStructureBuildRangeInfoKHR* const* ppBuildRangeInfos) {
@@ -21,9 +43,11 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.ranges = ppBuildRangeInfos;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
+  const uint32_t* captured = PreRecordCapture(*data, commandBuffer, infoCount, pInfos, ppBuildRangeInfos,
+                                              thread.data().captured_infos);
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
   RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuild, infoCount, pInfos, ppBuildRangeInfos,
-                 &thread.data().last_recorded);
+                 &thread.data().last_recorded, captured);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(

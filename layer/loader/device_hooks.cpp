@@ -3,6 +3,7 @@
 #include "history_host.h"
 #include "layer_data.h"
 #include "state_tracker.h"
+#include "vk_struct_chain.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
@@ -10,6 +11,14 @@ namespace asval::hooks {
 VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCallbacks* pAllocator) {
   if (!device) return;
   std::unique_ptr<DeviceData> data = Devices().Remove(GetDispatchKey(device));
+  if (data && data->capture_tracker) {
+    // The app waited for the device to be idle (it must, to destroy it): everything captured is read now.
+    CaptureTracker::Covered all;
+    all.all = true;
+    ProcessCaptures(*data, all);
+    data->capture_tracker.reset();
+    data->capture_pool->Shutdown();  // before the device goes; recordings still holding slabs give them back later
+  }
   if (data) ReportHistorySummary(data->state, *data->reporter, device);
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
 }
@@ -42,8 +51,18 @@ VKAPI_ATTR void VKAPI_CALL FreeMemory(VkDevice device, VkDeviceMemory memory, co
 VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice device, const VkBufferCreateInfo* pCreateInfo,
                                             const VkAllocationCallbacks* pAllocator, VkBuffer* pBuffer) {
   DeviceData* data = GetDeviceData(device);
-  const VkResult result = data->dispatch.CreateBuffer(device, pCreateInfo, pAllocator, pBuffer);
-  if (result == VK_SUCCESS) RecordCreateBuffer(data->state, *pCreateInfo, *pBuffer);
+  // Build inputs are copied by the capture (layer/capture): such buffers get TRANSFER_SRC, before the app asks
+  // for their memory requirements. A usage given by a pNext structure (VK_KHR_maintenance5) is left as it is.
+  VkBufferCreateInfo info = *pCreateInfo;
+  const bool usage_here = !FindInChain<BufferUsageFlags2CreateInfo>(info.pNext, kBufferUsageFlags2CreateInfo);
+  if (data->capture_tracker && usage_here &&
+      (info.usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR)) {
+    info.usage |= VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  }
+  const VkResult result = data->dispatch.CreateBuffer(device, &info, pAllocator, pBuffer);
+  if (result == VK_SUCCESS) {
+    RecordCreateBuffer(data->state, *pCreateInfo, *pBuffer, usage_here && (info.usage & VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  }
   return result;
 }
 

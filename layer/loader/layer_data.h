@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "capture_pool.h"
+#include "capture_recorder.h"
+#include "capture_tracker.h"
 #include "check_context.h"
 #include "device_state.h"
 #include "dispatch_key.h"
@@ -32,7 +35,24 @@ struct DeviceData {
   PFN_vkGetDeviceProcAddr next_gdpa = nullptr;
   Reporter* reporter = nullptr;  // the instance's
   DeviceState state;
+  // Execution-time capture (layer/capture): null when the capture setting is off or the history is not tracked.
+  // The tracker is destroyed before the pool (declaration order).
+  CaptureMode capture_mode = CaptureMode::kOff;
+  VkDeviceSize capture_budget = 0;
+  CaptureCounters capture_counters;
+  std::shared_ptr<CapturePool> capture_pool;
+  std::unique_ptr<CaptureTracker> capture_tracker;
 };
+
+// What the capture's pre-record of a build sees.
+inline CaptureContext MakeCaptureContext(DeviceData& data) {
+  return CaptureContext{data.state, data.dispatch, *data.capture_pool, data.capture_mode, data.capture_budget,
+                        data.capture_counters};
+}
+
+// Processes the submissions with captures that completed (or that `covered` names: the app's wait saw them
+// complete): their activity is filled and the update rules judged on it (capture_hooks.cpp).
+void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered);
 
 // What the validate functions of a hook see: the device's shadow state (const), the reporter, the families on.
 inline CheckContext MakeCheckContext(const DeviceData& data) {

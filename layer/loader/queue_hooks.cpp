@@ -14,7 +14,11 @@ namespace {
 
 // for_each_command_buffer(visit) calls visit(cb, location) for every submitted command buffer, in order.
 template <typename ForEachCommandBuffer, typename Downcall>
-VkResult Submit(DeviceData& data, ForEachCommandBuffer&& for_each_command_buffer, Downcall&& downcall) {
+VkResult Submit(DeviceData& data, VkQueue queue, VkFence fence, ForEachCommandBuffer&& for_each_command_buffer,
+                Downcall&& downcall) {
+  // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
+  // its capture memory (capture_tracker.h).
+  ProcessCaptures(data, CaptureTracker::Covered{});
   const CheckContext ctx = MakeCheckContext(data);
   HistorySubmission submission(data.state);
   SubmitChecks checks(ctx);
@@ -26,7 +30,11 @@ VkResult Submit(DeviceData& data, ForEachCommandBuffer&& for_each_command_buffer
     return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   const VkResult result = downcall();
-  if (result != VK_SUCCESS) submission.Undo();
+  if (result != VK_SUCCESS) {
+    submission.Undo();
+  } else if (data.capture_tracker && !submission.captures().empty()) {
+    data.capture_tracker->Track(queue, fence, std::move(submission.captures()));
+  }
   return result;
 }
 
@@ -36,7 +44,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, 
                                            VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
   return Submit(
-      *data,
+      *data, queue, fence,
       [&](auto&& visit) {
         const Location root("vkQueueSubmit");
         for (uint32_t i = 0; i < submitCount; ++i) {
@@ -53,7 +61,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t submitCount,
                                             VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
   return Submit(
-      *data,
+      *data, queue, fence,
       [&](auto&& visit) {
         const Location root("vkQueueSubmit2");
         for (uint32_t i = 0; i < submitCount; ++i) {

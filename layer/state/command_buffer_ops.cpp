@@ -131,7 +131,8 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
 
 void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                            const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                           const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+                           const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* log,
+                           const uint32_t* captured) {
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
     const bool has_geometries = info.pGeometries || info.ppGeometries;
@@ -154,6 +155,10 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
     op.type = info.type;
     op.geometry_count = info.geometryCount;
     op.first_geometry = static_cast<uint32_t>(geometries_.size());
+    if (captured && captured[i] != 0) {
+      op.capture_log = log;
+      op.capture_info = captured[i] - 1;
+    }
     if (!has_geometries && info.geometryCount != 0) op.geometries_unreadable = true;
     if (has_geometries && info.geometryCount != 0) {
       // Whether the info has ranges is decided once, not per geometry.

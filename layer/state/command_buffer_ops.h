@@ -16,6 +16,8 @@
 
 namespace asval {
 
+class CaptureLog;  // capture_log.h
+
 // The command an operation came from (for messages and ordinals).
 enum class OpCommand : uint8_t {
   kCmdBuild,
@@ -114,6 +116,11 @@ struct AsOp {
   // The geometries could not be read (a null ppGeometries[j], or neither array given with geometryCount > 0):
   // an invalid build, reported by the structure family; what it leaves in dst is unknown.
   bool geometries_unreadable = false;
+  // The bytes this build read, captured when it executes (issue 12): capture_info is its index in
+  // capture_log->infos; capture_log is null when the build was not captured. The log is kept alive by the
+  // published recording that holds this operation (RecordedOps::capture_logs).
+  CaptureLog* capture_log = nullptr;
+  uint32_t capture_info = 0;
 
   // kCopy, kSerialize, kDeserialize
   VkCopyAccelerationStructureModeKHR copy_mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
@@ -143,9 +150,11 @@ class OpBatch {
   }
 
   // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
+  // captured: per info, its index in `log`'s infos plus one (0: not captured); null when nothing was.
   void AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                    CaptureLog* log = nullptr, const uint32_t* captured = nullptr);
   // Any other operation (no geometries).
   void Append(const AsOp& op) { ops_.push_back(op); }
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.

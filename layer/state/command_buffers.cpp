@@ -8,6 +8,8 @@ void CommandBufferState::Reset() {
   recording.Clear();
   recording_lost = false;
   secondaries.clear();
+  capture_log.reset();  // a submission still reading it keeps it
+  executed_capture_logs.clear();
   calls_.fill(0);
   std::shared_ptr<const RecordedOps> old;
   {
@@ -21,10 +23,13 @@ void CommandBufferState::Reset() {
 void CommandBufferState::Publish() {
   std::shared_ptr<const RecordedOps> snapshot;
   if (!recording.empty() || recording_lost) {
+    // (A recording with captures always has the operations that refer to them.)
     std::shared_ptr<RecordedOps> fresh = spare_ ? std::move(spare_) : std::make_shared<RecordedOps>();
     fresh->batch.Swap(recording);  // the recording takes the spare's (cleared) storage
     recording.Clear();
     fresh->lost = recording_lost;
+    fresh->capture_logs = executed_capture_logs;
+    if (capture_log) fresh->capture_logs.push_back(capture_log);
     snapshot = std::move(fresh);
   }
   std::lock_guard<std::mutex> lock(published_mutex_);

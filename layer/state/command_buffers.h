@@ -19,6 +19,7 @@
 #include <mutex>
 #include <vector>
 
+#include "capture_log.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
 
@@ -30,6 +31,9 @@ struct RecordedOps {
   // Some operation could not be recorded (allocation failure, or a secondary the layer does not know was
   // executed): what this command buffer does to structures is unknown.
   bool lost = false;
+  // The capture logs its operations refer to (AsOp::capture_log): its own and those of the secondaries it
+  // executes. Held here so that they live as long as a submission may read them.
+  std::vector<std::shared_ptr<CaptureLog>> capture_logs;
 };
 
 class CommandBufferState {
@@ -47,6 +51,10 @@ class CommandBufferState {
   bool recording_lost = false;
   // Secondaries executed by vkCmdExecuteCommands, in order (the capture of execution-time data follows them).
   std::vector<VkCommandBuffer> secondaries;
+  // What this recording captures (layer/capture; made at its first capture), and the logs of the executed
+  // secondaries' recordings.
+  std::shared_ptr<CaptureLog> capture_log;
+  std::vector<std::shared_ptr<CaptureLog>> executed_capture_logs;
   // 1-based ordinal of the next call of `command`, for messages ("the 3rd vkCmd...").
   uint32_t NextOrdinal(OpCommand command) { return ++calls_[static_cast<std::size_t>(command)]; }
   // vkBeginCommandBuffer, vkResetCommandBuffer, vkResetCommandPool: empty recording, nothing published.

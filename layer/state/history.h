@@ -23,6 +23,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "build_activity.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
 #include "memory_range.h"
@@ -71,6 +72,10 @@ struct AsHistory {
   uint64_t serialization_size_generation = 0;
   // Where the structure's bytes are, once known (for aliasing clobbers).
   MemorySpan span;
+  // The primitive activity of the build or update that last executed on it, from its captured inputs (filled
+  // when that submission completes); null when that build was not captured (an update's activity rules are then
+  // skipped and counted).
+  std::shared_ptr<BuildActivity> activity;
 };
 
 // Bytes written by a serialization, with the history of the structure serialized.

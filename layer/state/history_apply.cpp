@@ -108,8 +108,39 @@ void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h
   ClobberOverlapping(store, span, dst, op, txn);
 }
 
+// A captured build's activity, filled when its submission completes; an update's comparison with its source's.
+// The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
+// one call) holds the bytes of the last execution only: both are unknown.
+std::shared_ptr<BuildActivity> CapturedActivity(const HistoryStore& store, const AsOp& op, SubmissionCaptures& captures) {
+  CaptureLog* log = op.capture_log;
+  auto node = std::make_shared<BuildActivity>(log->shared_from_this(), op.capture_info);
+  const auto key = std::make_pair(static_cast<const CaptureLog*>(log), op.capture_info);
+  auto [it, first] = captures.claimed.emplace(key, node.get());
+  if (!first) {
+    it->second->MarkUnknown();
+    node->MarkUnknown();
+  }
+  bool known_log = false;
+  for (const std::shared_ptr<CaptureLog>& held : captures.logs) known_log |= held.get() == log;
+  if (!known_log) captures.logs.push_back(log->shared_from_this());
+  captures.fills.push_back(node);
+  if (op.is_update()) {
+    const AsHistory* src = store.Find(op.src);
+    ActivityComparison comparison;
+    comparison.before = src ? src->activity : nullptr;
+    if (src && src->build) comparison.source_build = src->build->origin;
+    comparison.after = node;
+    comparison.update = op.origin;
+    comparison.src = op.src;
+    comparison.dst = op.dst;
+    comparison.device_build = op.origin.command != OpCommand::kCmdBuildIndirect;
+    captures.comparisons.push_back(std::move(comparison));
+  }
+  return node;
+}
+
 void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
-                Transaction* txn) {
+                Transaction* txn, SubmissionCaptures* captures) {
   std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
   AsHistory& h = *fresh;
@@ -127,6 +158,7 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
     const AsHistory* old = store.Find(op.dst);
     h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);
   }
+  if (captures && op.capture_log) h.activity = CapturedActivity(store, op, *captures);
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
 
@@ -138,6 +170,7 @@ void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Tr
   if (src.kind == HistoryKind::kBuilt) {
     h.kind = HistoryKind::kBuilt;
     h.build = src.build;
+    h.activity = src.activity;  // a clone or compaction keeps every primitive as it was
   } else {
     // Copying a structure never built is its own error (src-04963); what lands in dst is unknown either way.
     h.kind = HistoryKind::kUnknown;
@@ -233,10 +266,11 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
   store.InvalidateAllBlobs(txn);
 }
 
-void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn) {
+void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
+             SubmissionCaptures* captures) {
   store.ops_applied.fetch_add(1, std::memory_order_relaxed);
   switch (op.kind) {
-    case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn); break;
+    case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
     case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;
     case OpKind::kSerialize: ApplySerialize(store, op, txn); break;
     case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn); break;

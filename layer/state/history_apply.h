@@ -14,8 +14,11 @@ namespace asval {
 std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as);
 
 // Applies one operation of `batch` to the histories in `state.history.store`. txn (may be null) collects the
-// changes so that a skipped or failed submission can be rolled back.
-void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn);
+// changes so that a skipped or failed submission can be rolled back. captures (may be null: host operations,
+// which capture nothing) collects what the submission's captured builds ask for once it completes: their
+// activity, and the updates to compare with their sources'.
+void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
+             SubmissionCaptures* captures = nullptr);
 
 // A command buffer the layer never saw allocated, or whose operations it could not record, was submitted:
 // every structure that exists now gets an unknown history (undone with the submission, through txn).

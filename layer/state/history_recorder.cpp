@@ -96,11 +96,14 @@ void ApplyNow(DeviceState& state, const OpBatch& batch) {
 
 void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last) {
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last,
+                    const uint32_t* captured) {
   CommandBufferState* recording = RecordingBuild(state, cb, last ? *last : ThisThreadsLastRecordedBuild());
   if (!recording || !infos) return;
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
-  Guarded(*recording, [&] { recording->recording.AppendBuilds(origin, info_count, infos, ranges); });
+  Guarded(*recording, [&] {
+    recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured);
+  });
 }
 
 void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info) {
@@ -167,7 +170,11 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
     const std::shared_ptr<const RecordedOps> ops = secondary->Executable();
     if (!ops) continue;
     if (ops->lost) recording->recording_lost = true;
-    Guarded(*recording, [&] { recording->recording.AppendExecuted(ops->batch, primary); });
+    Guarded(*recording, [&] {
+      recording->recording.AppendExecuted(ops->batch, primary);
+      recording->executed_capture_logs.insert(recording->executed_capture_logs.end(), ops->capture_logs.begin(),
+                                              ops->capture_logs.end());
+    });
   }
 }
 

@@ -22,10 +22,13 @@ struct LastRecordedBuild {
 };
 
 // ranges: null for indirect builds (the counts are on the device). last: the calling thread's memo, kept by the
-// caller with its other per-thread data (null: a thread_local of the recorder's own).
+// caller with its other per-thread data (null: a thread_local of the recorder's own). captured: per info, its
+// index in the command buffer's capture log plus one (0: not captured), from the capture's pre-record; null when
+// the call captured nothing.
 void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last = nullptr);
+                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last = nullptr,
+                    const uint32_t* captured = nullptr);
 void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info);
 void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
                            const VkCopyAccelerationStructureToMemoryInfoKHR& info);

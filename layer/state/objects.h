@@ -27,6 +27,8 @@ struct BufferState {
   VkDeviceSize size = 0;
   VkBufferUsageFlags usage = 0;
   VkBufferCreateFlags create_flags = 0;
+  // Created with TRANSFER_SRC usage, the app's or added by the layer (vkCreateBuffer): the capture may copy it.
+  bool capture_source = false;
   // Binding, set by vkBindBufferMemory(2); a sparse buffer is never "bound" this way.
   bool bound = false;
   VkDeviceMemory memory = VK_NULL_HANDLE;

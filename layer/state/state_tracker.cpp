@@ -5,19 +5,6 @@
 
 namespace asval {
 
-namespace {
-
-// VK_KHR_maintenance5's VkBufferUsageFlags2CreateInfoKHR is newer than the 1.3.239 headers. When an app chains
-// it, its 64-bit usage replaces VkBufferCreateInfo::usage, so the layer must read it to know the real usage.
-constexpr VkStructureType kBufferUsageFlags2CreateInfo = static_cast<VkStructureType>(1000470006);
-struct BufferUsageFlags2CreateInfo {
-  VkStructureType sType;
-  const void* pNext;
-  uint64_t usage;
-};
-
-}  // namespace
-
 void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
   auto record = std::make_shared<MemoryState>();
   record->handle = memory;
@@ -59,7 +46,7 @@ void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
   state.history.store.ForgetMemory(memory);
 }
 
-void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer) {
+void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer, bool copyable) {
   auto record = std::make_shared<BufferState>();
   record->handle = buffer;
   record->id = state.NextObjectId();
@@ -70,6 +57,7 @@ void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBu
     record->usage = static_cast<VkBufferUsageFlags>(usage2->usage & 0xffffffffu);
   }
   record->create_flags = info.flags;
+  record->capture_source = copyable;
   state.buffers.insert_or_assign(buffer, std::move(record));
 }
 

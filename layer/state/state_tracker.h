@@ -15,7 +15,9 @@ struct DeviceDispatchTable;
 void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory);
 void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory);
 
-void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer);
+// info: as the app gave it. copyable: the buffer was created with TRANSFER_SRC (the app's, or the layer's for
+// build inputs): the capture may copy from it.
+void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer, bool copyable = false);
 void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer);
 // Publishes the binding and, for SHADER_DEVICE_ADDRESS buffers, queries and maps the device address.
 void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device, VkBuffer buffer,

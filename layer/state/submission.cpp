@@ -15,6 +15,7 @@ void HistorySubmission::Begin() {
 }
 
 void HistorySubmission::Undo() {
+  captures_ = SubmissionCaptures{};  // nothing executes: nothing to read
   if (txn_.empty()) return;
   if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
   state_.history.store.Undo(txn_);

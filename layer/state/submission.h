@@ -53,7 +53,7 @@ class HistorySubmission {
     txn_.ReserveMore(batch.ops().size() * 2);  // one entry per written structure, and some clobbers
     for (const AsOp& op : batch.ops()) {
       check(static_cast<const HistoryStore&>(state_.history.store), batch, op);
-      ApplyOp(state_, state_.history.store, batch, op, &txn_);
+      ApplyOp(state_, state_.history.store, batch, op, &txn_, &captures_);
       ++ops_applied_;
     }
   }
@@ -65,6 +65,8 @@ class HistorySubmission {
   void Undo();
 
   uint64_t ops_applied() const { return ops_applied_; }
+  // What the submission's captured builds ask for once it completes (empty after Undo).
+  SubmissionCaptures& captures() { return captures_; }
 
  private:
   // False when the command buffer does nothing to structures; *ops null when what it does is unknown.
@@ -76,6 +78,7 @@ class HistorySubmission {
   std::unique_lock<std::recursive_mutex> order_lock_;
   std::unique_lock<std::mutex> store_lock_;
   Transaction txn_;
+  SubmissionCaptures captures_;
   uint64_t ops_applied_ = 0;
 };
 

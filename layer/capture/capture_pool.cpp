@@ -1,0 +1,103 @@
+#include "capture_pool.h"
+
+#include <algorithm>
+
+namespace asval {
+
+namespace {
+
+uint32_t PickMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t allowed) {
+  constexpr VkMemoryPropertyFlags kNeeded = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  uint32_t fallback = UINT32_MAX;
+  for (uint32_t t = 0; t < memory.memoryTypeCount; ++t) {
+    if (!(allowed & (1u << t))) continue;
+    const VkMemoryPropertyFlags flags = memory.memoryTypes[t].propertyFlags;
+    if ((flags & kNeeded) != kNeeded) continue;
+    if (flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) return t;
+    if (fallback == UINT32_MAX) fallback = t;
+  }
+  return fallback;
+}
+
+}  // namespace
+
+CapturePool::CapturePool(VkDevice device, const DeviceDispatchTable& next,
+                         const VkPhysicalDeviceMemoryProperties& memory)
+    : device_(device), next_(next) {
+  memory_type_ = PickMemoryType(memory, ~0u);
+}
+
+CapturePool::~CapturePool() { Shutdown(); }
+
+bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
+  if (memory_type_ == UINT32_MAX || !next_.CreateBuffer || !next_.AllocateMemory || !next_.MapMemory) return false;
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = bytes;
+  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  CaptureSlab s;
+  s.size = bytes;
+  if (next_.CreateBuffer(device_, &info, nullptr, &s.buffer) != VK_SUCCESS) return false;
+  VkMemoryRequirements requirements{};
+  next_.GetBufferMemoryRequirements(device_, s.buffer, &requirements);
+  VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.allocationSize = requirements.size;
+  allocate.memoryTypeIndex = memory_type_;
+  void* mapped = nullptr;
+  if (!(requirements.memoryTypeBits & (1u << memory_type_)) ||
+      next_.AllocateMemory(device_, &allocate, nullptr, &s.memory) != VK_SUCCESS) {
+    next_.DestroyBuffer(device_, s.buffer, nullptr);
+    return false;
+  }
+  if (next_.BindBufferMemory(device_, s.buffer, s.memory, 0) != VK_SUCCESS ||
+      next_.MapMemory(device_, s.memory, 0, VK_WHOLE_SIZE, 0, &mapped) != VK_SUCCESS) {
+    next_.DestroyBuffer(device_, s.buffer, nullptr);
+    next_.FreeMemory(device_, s.memory, nullptr);
+    return false;
+  }
+  s.mapped = static_cast<const uint8_t*>(mapped);
+  *slab = s;
+  return true;
+}
+
+void CapturePool::Destroy(const CaptureSlab& slab) {
+  next_.DestroyBuffer(device_, slab.buffer, nullptr);
+  next_.FreeMemory(device_, slab.memory, nullptr);  // unmaps
+}
+
+bool CapturePool::Take(VkDeviceSize bytes, CaptureSlab* slab) {
+  const VkDeviceSize wanted = std::max(bytes, kSlabBytes);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (shut_down_) return false;
+    for (std::size_t k = 0; k < free_.size(); ++k) {
+      if (free_[k].size >= bytes) {
+        *slab = free_[k];
+        free_[k] = free_.back();
+        free_.pop_back();
+        return true;
+      }
+    }
+  }
+  if (!Create(wanted, slab)) return false;
+  std::lock_guard<std::mutex> lock(mutex_);
+  all_.push_back(*slab);
+  return true;
+}
+
+void CapturePool::Return(const CaptureSlab& slab) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shut_down_) return;  // destroyed with the device already
+  free_.push_back(slab);
+}
+
+void CapturePool::Shutdown() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shut_down_) return;
+  shut_down_ = true;
+  for (const CaptureSlab& slab : all_) Destroy(slab);
+  all_.clear();
+  free_.clear();
+}
+
+}  // namespace asval

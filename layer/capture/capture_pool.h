@@ -1,0 +1,45 @@
+#pragma once
+// Layer-owned host-visible memory that device builds' inputs are copied into (execution-time capture, issue 12):
+// slabs of one VkBuffer each, bound to their own HOST_VISIBLE | HOST_COHERENT memory and mapped for life. A
+// recording takes slabs as it captures (CaptureLog) and gives them back when nothing reads it any more; they are
+// reused. Every call goes to the next element of the chain, never to the layer's own hooks.
+#include <vulkan/vulkan.h>
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "capture_log.h"
+#include "vk_dispatch_table.h"
+
+namespace asval {
+
+class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this<CapturePool> {
+ public:
+  // Slabs are at least this large (a slab serves many captures of one recording).
+  static constexpr VkDeviceSize kSlabBytes = VkDeviceSize{4} << 20;
+
+  CapturePool(VkDevice device, const DeviceDispatchTable& next, const VkPhysicalDeviceMemoryProperties& memory);
+  ~CapturePool() override;
+
+  // A slab of at least `bytes`; nullopt when the device cannot give one (no host-visible coherent memory type,
+  // out of memory): the capture is then skipped and counted.
+  bool Take(VkDeviceSize bytes, CaptureSlab* slab);
+  void Return(const CaptureSlab& slab) override;
+  // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
+  void Shutdown();
+
+ private:
+  bool Create(VkDeviceSize bytes, CaptureSlab* slab);
+  void Destroy(const CaptureSlab& slab);
+
+  const VkDevice device_;
+  const DeviceDispatchTable& next_;
+  uint32_t memory_type_ = UINT32_MAX;  // HOST_VISIBLE | HOST_COHERENT, HOST_CACHED preferred (the host reads)
+  std::mutex mutex_;
+  std::vector<CaptureSlab> free_;
+  std::vector<CaptureSlab> all_;  // every live slab, for Shutdown
+  bool shut_down_ = false;
+};
+
+}  // namespace asval

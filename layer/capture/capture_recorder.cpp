@@ -1,0 +1,193 @@
+#include "capture_recorder.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "asval/vertex_formats.h"
+
+namespace asval {
+
+namespace {
+
+constexpr VkDeviceSize kNoBytes = std::numeric_limits<VkDeviceSize>::max();
+constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);  // 24
+constexpr VkDeviceSize kAlignment = 16;
+
+VkDeviceSize Add(VkDeviceSize a, VkDeviceSize b) { return a > kNoBytes - b ? kNoBytes : a + b; }
+VkDeviceSize Mul(VkDeviceSize a, VkDeviceSize b) { return b != 0 && a > kNoBytes / b ? kNoBytes : a * b; }
+
+int IndexBytes(VkIndexType type) {
+  switch (type) {
+    case VK_INDEX_TYPE_UINT16: return 2;
+    case VK_INDEX_TYPE_UINT32: return 4;
+    case VK_INDEX_TYPE_NONE_KHR: return 0;
+    default: return -1;  // UINT8 and others: not captured yet
+  }
+}
+
+// One range to copy: from a device address into the capture log.
+struct Source {
+  VkDeviceAddress address;
+  VkDeviceSize size;
+  CapturedBytes* into;
+};
+
+// The ranges geometry g reads (exactly the bytes the specification says a build consumes, from where it starts
+// reading), with the captured geometry's parameters rewritten for bytes that start there. False when the
+// geometry is not captured.
+bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerationStructureBuildRangeInfoKHR& r,
+                  CapturedGeometry* out, std::vector<Source>& sources, std::size_t geometry_index) {
+  (void)geometry_index;
+  out->type = g.geometryType;
+  out->range.primitiveCount = r.primitiveCount;
+  const VkDeviceSize n = r.primitiveCount;
+  if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
+    const VertexFormatInfo& format = VertexFormatFacts(t.vertexFormat);
+    const int index_bytes = IndexBytes(t.indexType);
+    if (!format.decodable || index_bytes < 0) return false;
+    out->vertex_format = t.vertexFormat;
+    out->vertex_stride = t.vertexStride;
+    out->index_type = t.indexType;
+    if (n == 0) return true;
+    if (t.vertexData.deviceAddress == 0) return false;
+    if (index_bytes == 0) {
+      // Vertex k of the range is read at primitiveOffset + stride * (firstVertex + k); the last one for its size.
+      const VkDeviceSize first = Add(r.primitiveOffset, Mul(t.vertexStride, r.firstVertex));
+      const VkDeviceSize bytes = Add(Mul(t.vertexStride, Mul(3, n) - 1), format.vertexBytes);
+      out->max_vertex = t.maxVertex >= r.firstVertex ? t.maxVertex - r.firstVertex : 0;
+      sources.push_back(Source{Add(t.vertexData.deviceAddress, first), bytes, &out->data});
+    } else {
+      if (t.indexData.deviceAddress == 0) return false;
+      // Indices from primitiveOffset; vertices index + firstVertex up to maxVertex, from vertexData.
+      out->max_vertex = t.maxVertex;
+      out->range.firstVertex = r.firstVertex;
+      sources.push_back(Source{Add(t.indexData.deviceAddress, r.primitiveOffset), Mul(Mul(3, n), index_bytes),
+                               &out->indices});
+      sources.push_back(
+          Source{t.vertexData.deviceAddress, Add(Mul(t.vertexStride, t.maxVertex), format.vertexBytes), &out->data});
+    }
+    return true;
+  }
+  if (g.geometryType == VK_GEOMETRY_TYPE_AABBS_KHR) {
+    const VkAccelerationStructureGeometryAabbsDataKHR& a = g.geometry.aabbs;
+    out->aabb_stride = a.stride;
+    if (n == 0) return true;
+    if (a.data.deviceAddress == 0) return false;
+    sources.push_back(
+        Source{Add(a.data.deviceAddress, r.primitiveOffset), Add(Mul(a.stride, n - 1), kAabbBytes), &out->data});
+    return true;
+  }
+  return false;  // instances: not captured yet
+}
+
+// The buffer a range can be copied from: bound, created copyable by the layer, holding the whole range.
+std::optional<AddressHit> CopyableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
+  return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
+    std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(buffer);
+    return b && *b && (*b)->bound && (*b)->capture_source;
+  });
+}
+
+// Room for `size` bytes in the log; false when no slab could be had.
+bool Allocate(const CaptureContext& ctx, CaptureLog& log, VkDeviceSize size, CapturedBytes* where) {
+  const VkDeviceSize offset = (log.used_in_last_slab + kAlignment - 1) & ~(kAlignment - 1);
+  if (log.slabs.empty() || offset > log.slabs.back().size || size > log.slabs.back().size - offset) {
+    CaptureSlab slab;
+    if (!ctx.pool.Take(size, &slab)) return false;
+    log.slabs.push_back(slab);
+    log.used_in_last_slab = 0;
+    return Allocate(ctx, log, size, where);
+  }
+  where->slab = static_cast<uint32_t>(log.slabs.size() - 1);
+  where->offset = offset;
+  where->size = size;
+  log.used_in_last_slab = offset + size;
+  return true;
+}
+
+struct Copy {
+  VkBuffer src;
+  VkBuffer dst;
+  VkBufferCopy region;
+};
+
+void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies) {
+  // Earlier writes of any kind (the app's own copies, fills, shaders) become visible to the transfer read.
+  VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  before.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+  before.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0,
+                              nullptr, 0, nullptr);
+  for (const Copy& c : copies) ctx.next.CmdCopyBuffer(cb, c.src, c.dst, 1, &c.region);
+  // The copies are visible to the host once the submission completes; later commands (writes of the inputs
+  // included) wait for the reads.
+  VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                              VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after, 0, nullptr,
+                              0, nullptr);
+}
+
+}  // namespace
+
+bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                        uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                        const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                        std::vector<uint32_t>& captured) {
+  captured.clear();
+  if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
+  std::vector<Copy> copies;
+  std::vector<Source> sources;
+  for (uint32_t i = 0; i < info_count; ++i) {
+    const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    if (!NeedsCapture(ctx.mode, info)) continue;
+    if (captured.empty()) captured.assign(info_count, 0);
+    const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges[i];
+    if (!info_ranges || (!info.pGeometries && !info.ppGeometries)) {
+      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    if (!recording.capture_log) recording.capture_log = std::make_shared<CaptureLog>(ctx.pool.shared_from_this());
+    CaptureLog& log = *recording.capture_log;
+    CapturedInfo entry;
+    entry.first_geometry = static_cast<uint32_t>(log.geometries.size());
+    entry.geometry_count = info.geometryCount;
+    log.geometries.resize(log.geometries.size() + info.geometryCount);
+    sources.clear();
+    for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
+      const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+      entry.complete = g && PlanGeometry(*g, info_ranges[j], &log.geometries[entry.first_geometry + j], sources, j);
+    }
+    VkDeviceSize total = 0;
+    for (const Source& s : sources) total = Add(total, s.size);
+    if (entry.complete && Add(log.bytes_captured, total) > ctx.budget_bytes) entry.complete = false;
+    const std::size_t first_copy = copies.size();
+    for (const Source& s : sources) {
+      if (!entry.complete) break;
+      const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
+      if (!hit || !Allocate(ctx, log, s.size, s.into)) {
+        entry.complete = false;
+        break;
+      }
+      s.into->present = true;
+      copies.push_back(Copy{hit->buffer, log.slabs[s.into->slab].buffer,
+                            VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
+    }
+    if (!entry.complete) {
+      copies.resize(first_copy);
+      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      log.bytes_captured = Add(log.bytes_captured, total);
+      ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
+      ctx.counters.bytes_captured.fetch_add(total, std::memory_order_relaxed);
+    }
+    log.infos.push_back(entry);
+    captured[i] = static_cast<uint32_t>(log.infos.size());
+  }
+  if (!copies.empty()) RecordCopies(ctx, cb, copies);
+  return !captured.empty();
+}
+
+}  // namespace asval

@@ -1,0 +1,56 @@
+#pragma once
+// Pre-record of a device build (execution-time capture, issue 12): decides which infos' inputs a rule needs at
+// execution time and records, through the next element of the chain and before the app's build, a barrier
+// that makes earlier writes visible to a transfer read, one copy per input range into the recording's capture
+// log, and a barrier that makes the copies visible to the host and keeps later writes behind the reads.
+//
+// Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
+// update's source: their activity record) and updates; with `all`, every bottom-level build. Triangles and AABBs
+// only so far: an info with instances or a vertex format the builder does not decode is not captured (its
+// rules are skipped and counted when they would need it).
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "capture_pool.h"
+#include "device_state.h"
+#include "vk_dispatch_table.h"
+
+namespace asval {
+
+enum class CaptureMode : uint8_t { kOff, kUpdates, kAll };
+
+struct CaptureCounters {
+  std::atomic<uint64_t> infos_captured{0};
+  std::atomic<uint64_t> bytes_captured{0};
+  // Infos a rule needed but that could not be captured (no copyable buffer, over the budget, a geometry kind
+  // or format not captured yet, no host-visible memory).
+  std::atomic<uint64_t> infos_not_captured{0};
+};
+
+struct CaptureContext {
+  const DeviceState& state;
+  const DeviceDispatchTable& next;
+  CapturePool& pool;
+  CaptureMode mode;
+  VkDeviceSize budget_bytes;  // per recording
+  CaptureCounters& counters;
+};
+
+// Whether a build info needs its inputs captured (cheap: the hot path of builds that need none).
+inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeometryInfoKHR& info) {
+  if (mode == CaptureMode::kOff || info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
+  return mode == CaptureMode::kAll || info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
+         (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
+}
+
+// vkCmdBuildAccelerationStructuresKHR: records the captures of the infos that need them into cb (whose state
+// is `recording`) and writes, per info, its index in recording.capture_log->infos plus one, or 0, into
+// `captured` (resized to info_count). False when nothing was captured (captured is then left empty).
+bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                        uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                        const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, std::vector<uint32_t>& captured);
+
+}  // namespace asval

@@ -1,0 +1,109 @@
+#include "capture_tracker.h"
+
+#include <algorithm>
+
+namespace asval {
+
+namespace {
+
+// Long enough for any work the app's own wait already saw complete; a hung device is not waited for forever.
+constexpr uint64_t kCoveredWaitNs = 10ull * 1000 * 1000 * 1000;
+
+thread_local bool t_processing = false;
+
+}  // namespace
+
+CaptureTracker::~CaptureTracker() {
+  for (Pending& p : pending_) {
+    if (p.fence) next_.DestroyFence(device_, p.fence, nullptr);
+  }
+  for (VkFence f : free_fences_) next_.DestroyFence(device_, f, nullptr);
+}
+
+VkFence CaptureTracker::TakeFence() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!free_fences_.empty()) {
+      VkFence f = free_fences_.back();
+      free_fences_.pop_back();
+      return f;
+    }
+  }
+  VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  if (!next_.CreateFence || next_.CreateFence(device_, &info, nullptr, &fence) != VK_SUCCESS) return VK_NULL_HANDLE;
+  return fence;
+}
+
+void CaptureTracker::Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures) {
+  if (captures.empty()) return;
+  const VkFence fence = TakeFence();
+  // Without a fence of its own the layer cannot know when the bytes are there: nothing is read (unknown).
+  if (!fence || next_.QueueSubmit(queue, 0, nullptr, fence) != VK_SUCCESS) {
+    for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
+    if (fence) next_.DestroyFence(device_, fence, nullptr);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
+    // Pending twice (SIMULTANEOUS_USE): the device writes the same capture bytes twice before they are read.
+    if (log->pending_submissions > 0) log->overlapped = true;
+    ++log->pending_submissions;
+  }
+  pending_.push_back(Pending{queue, app_fence, fence, std::move(captures)});
+}
+
+void CaptureTracker::Retire(Pending& p) {
+  for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) {
+    if (--log->pending_submissions == 0) log->overlapped = false;
+  }
+  next_.ResetFences(device_, 1, &p.fence);
+  free_fences_.push_back(p.fence);
+  p.fence = VK_NULL_HANDLE;
+}
+
+void CaptureTracker::Process(const Covered& covered, const OnComplete& on_complete) {
+  if (t_processing) return;
+  std::lock_guard<std::recursive_mutex> order(processing_);
+  t_processing = true;
+  // Submissions up to the last one carrying a waited app fence are covered: that fence signaled, so that
+  // submission completed, and the layer's fence of each earlier one is at most a moment away.
+  std::size_t covered_until = 0;  // pending_ entries [0, covered_until) with a covered app fence
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (std::size_t k = 0; k < pending_.size(); ++k) {
+      const Pending& p = pending_[k];
+      if (p.app_fence && std::find(covered.fences, covered.fences + covered.fence_count, p.app_fence) !=
+                             covered.fences + covered.fence_count) {
+        covered_until = k + 1;
+      }
+    }
+  }
+  for (std::size_t k = 0;; ++k) {
+    Pending current;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (pending_.empty()) break;
+      Pending& p = pending_.front();
+      VkResult status = next_.GetFenceStatus(device_, p.fence);
+      const bool covered_here = k < covered_until || covered.all || (covered.queue && p.queue == covered.queue);
+      if (status == VK_NOT_READY && covered_here) {
+        status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
+      }
+      if (status != VK_SUCCESS) break;  // still pending (or the device was lost): later, in order
+      current = std::move(p);
+      pending_.pop_front();
+    }
+    on_complete(current.captures);
+    std::lock_guard<std::mutex> lock(mutex_);
+    Retire(current);
+  }
+  t_processing = false;
+}
+
+bool CaptureTracker::idle() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return pending_.empty();
+}
+
+}  // namespace asval

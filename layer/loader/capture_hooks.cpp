@@ -1,0 +1,98 @@
+// Execution-time capture (issue 12): the waits through which the app learns that work completed. Each calls
+// down first; once the app's wait succeeded, the submissions with captures it covers are processed (their
+// captured builds' activity filled, the update rules judged on it), so that findings are reported before the
+// app's wait returns.
+#include <vector>
+
+#include "activity_rules.h"
+#include "layer_data.h"
+#include "vk_intercepts.h"
+
+namespace asval {
+
+void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
+  if (!data.capture_tracker || data.capture_tracker->idle()) return;
+  const CheckContext ctx = MakeCheckContext(data);
+  data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
+    for (const std::shared_ptr<BuildActivity>& activity : done.fills) activity->Fill();
+    for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
+  });
+}
+
+namespace hooks {
+
+VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
+  DeviceData* data = GetDeviceData(queue);
+  const VkResult result = data->dispatch.QueueWaitIdle(queue);
+  if (result == VK_SUCCESS) {
+    CaptureTracker::Covered covered;
+    covered.queue = queue;
+    ProcessCaptures(*data, covered);
+  }
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL DeviceWaitIdle(VkDevice device) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.DeviceWaitIdle(device);
+  if (result == VK_SUCCESS) {
+    CaptureTracker::Covered covered;
+    covered.all = true;
+    ProcessCaptures(*data, covered);
+  }
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL WaitForFences(VkDevice device, uint32_t fenceCount, const VkFence* pFences,
+                                             VkBool32 waitAll, uint64_t timeout) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.WaitForFences(device, fenceCount, pFences, waitAll, timeout);
+  if (result == VK_SUCCESS && data->capture_tracker && !data->capture_tracker->idle()) {
+    CaptureTracker::Covered covered;
+    std::vector<VkFence> signaled;
+    if (waitAll || fenceCount == 1) {
+      covered.fences = pFences;
+      covered.fence_count = fenceCount;
+    } else {
+      // waitAny: only the fences that signaled are covered.
+      for (uint32_t k = 0; k < fenceCount; ++k) {
+        if (data->dispatch.GetFenceStatus(device, pFences[k]) == VK_SUCCESS) signaled.push_back(pFences[k]);
+      }
+      covered.fences = signaled.data();
+      covered.fence_count = static_cast<uint32_t>(signaled.size());
+    }
+    ProcessCaptures(*data, covered);
+  }
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL GetFenceStatus(VkDevice device, VkFence fence) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.GetFenceStatus(device, fence);
+  if (result == VK_SUCCESS) {
+    CaptureTracker::Covered covered;
+    covered.fences = &fence;
+    covered.fence_count = 1;
+    ProcessCaptures(*data, covered);
+  }
+  return result;
+}
+
+// Semaphore waits say nothing the layer maps to its submissions: what completed by now is processed.
+VKAPI_ATTR VkResult VKAPI_CALL WaitSemaphores(VkDevice device, const VkSemaphoreWaitInfo* pWaitInfo,
+                                              uint64_t timeout) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.WaitSemaphores(device, pWaitInfo, timeout);
+  if (result == VK_SUCCESS) ProcessCaptures(*data, CaptureTracker::Covered{});
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL GetSemaphoreCounterValue(VkDevice device, VkSemaphore semaphore, uint64_t* pValue) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.GetSemaphoreCounterValue(device, semaphore, pValue);
+  if (result == VK_SUCCESS) ProcessCaptures(*data, CaptureTracker::Covered{});
+  return result;
+}
+
+}  // namespace hooks
+}  // namespace asval

@@ -1,0 +1,68 @@
+#include "build_activity.h"
+
+#include "asval/builder/classify.h"
+
+namespace asval {
+
+namespace {
+
+// The builder's view of one captured geometry; false when its bytes were not captured.
+bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record) {
+  if (g.range.primitiveCount == 0) {
+    *record = builder::ActivityRecord{};
+    return true;
+  }
+  if (!g.data.present) return false;
+  builder::ClassifyResult result;
+  if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    if (g.index_type != VK_INDEX_TYPE_NONE_KHR && !g.indices.present) return false;
+    builder::TriangleGeometryView view;
+    view.vertexData = log.Bytes(g.data);
+    view.vertexDataBytes = g.data.size;
+    view.vertexFormat = g.vertex_format;
+    view.vertexStride = g.vertex_stride;
+    view.maxVertex = g.max_vertex;
+    view.indexType = g.index_type;
+    if (g.indices.present) {
+      view.indexData = log.Bytes(g.indices);
+      view.indexDataBytes = g.indices.size;
+    }
+    view.range = g.range;
+    result = builder::ClassifyTriangles(view, record, nullptr);
+  } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
+    builder::AabbGeometryView view;
+    view.data = log.Bytes(g.data);
+    view.dataBytes = g.data.size;
+    view.stride = g.aabb_stride;
+    view.range = g.range;
+    result = builder::ClassifyAabbs(view, record, nullptr);
+  } else {
+    return false;
+  }
+  // Primitives whose bytes the copy did not reach are recorded active: a guess. Unknown instead.
+  return result.status == builder::ClassifyStatus::Ok && result.unreadable == 0 && !result.indexHashPartial;
+}
+
+}  // namespace
+
+void BuildActivity::Fill() {
+  if (status_ != Status::kPending) return;
+  const CaptureLog* log = log_.get();
+  if (!log || log->overlapped || info_ >= log->infos.size() || !log->infos[info_].complete) {
+    MarkUnknown();
+    return;
+  }
+  const CapturedInfo& info = log->infos[info_];
+  geometries_.resize(info.geometry_count);
+  for (uint32_t j = 0; j < info.geometry_count; ++j) {
+    if (!Classify(*log, log->geometries[info.first_geometry + j], &geometries_[j])) {
+      geometries_.clear();
+      MarkUnknown();
+      return;
+    }
+  }
+  status_ = Status::kReady;
+  log_.reset();
+}
+
+}  // namespace asval

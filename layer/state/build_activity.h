@@ -1,0 +1,70 @@
+#pragma once
+// The primitive activity of one executed build or update (issue 12): per geometry, which primitives were active
+// (the reference builder's ActivityRecord: one bit per primitive, and a fingerprint of the index values), read
+// from the bytes the layer captured when the build executed. A structure's history holds the activity of the
+// build that last executed on it (AsHistory::activity); an update is compared with its source's.
+//
+// Created pending when a submission is applied (submission order), filled when that submission completes
+// (CaptureTracker, layer/capture), in submission order, under the device's capture processing lock, which every
+// reader holds too.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "asval/builder/activity_record.h"
+#include "capture_log.h"
+#include "command_buffer_ops.h"
+
+namespace asval {
+
+class BuildActivity {
+ public:
+  enum class Status : uint8_t { kPending, kReady, kUnknown };
+
+  BuildActivity(std::shared_ptr<const CaptureLog> log, uint32_t info) : log_(std::move(log)), info_(info) {}
+
+  Status status() const { return status_; }
+  // kReady: one record per geometry of the build.
+  const std::vector<builder::ActivityRecord>& geometries() const { return geometries_; }
+
+  // Classifies the captured bytes (the submission completed). Geometries the builder cannot classify (a format
+  // it does not decode, bytes not captured) leave the whole activity unknown.
+  void Fill();
+  // The bytes cannot be trusted (the same capture written twice before it was read): unknown.
+  void MarkUnknown() {
+    status_ = Status::kUnknown;
+    log_.reset();
+  }
+  const CaptureLog* log() const { return log_.get(); }
+
+ private:
+  Status status_ = Status::kPending;
+  std::shared_ptr<const CaptureLog> log_;  // until filled
+  uint32_t info_ = 0;
+  std::vector<builder::ActivityRecord> geometries_;
+};
+
+// An update to compare with the activity of its source's last executed build (pInfos-03663, 03664, 03768).
+struct ActivityComparison {
+  std::shared_ptr<BuildActivity> before;  // null: the source's last build was not captured
+  std::shared_ptr<BuildActivity> after;   // the update's own activity
+  OpOrigin update;                        // the update (for messages)
+  OpOrigin source_build;                  // the build that produced `before` (for messages)
+  VkAccelerationStructureKHR src = VK_NULL_HANDLE;
+  VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+  bool device_build = true;  // vkCmdBuildAccelerationStructuresKHR (else the indirect command): names the VUIDs
+};
+
+// What one submission's captures ask for once it completes, in submission order.
+struct SubmissionCaptures {
+  std::vector<std::shared_ptr<BuildActivity>> fills;
+  std::vector<ActivityComparison> comparisons;
+  // The recordings whose captures this submission reads (each counted once in pending_submissions).
+  std::vector<std::shared_ptr<CaptureLog>> logs;
+  // Each capture read once per submission (history_apply.cpp).
+  std::map<std::pair<const CaptureLog*, uint32_t>, BuildActivity*> claimed;
+  bool empty() const { return fills.empty(); }
+};
+
+}  // namespace asval

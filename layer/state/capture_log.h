@@ -1,0 +1,92 @@
+#pragma once
+// What one recording of a command buffer captured (execution-time capture, issue 12): for each captured build
+// info, where the bytes its geometries are built from land in layer-owned host-visible memory when the command
+// buffer executes, and how the reference builder must read them. The copies themselves are recorded by
+// layer/capture, before the app's build; the bytes are read once the submission that ran them completes.
+//
+// Threads: written only by the thread recording the command buffer (the app synchronizes it); read after the
+// recording was published (vkEndCommandBuffer), when a submission of it completes, under the device's capture
+// processing lock (CaptureTracker, layer/capture).
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "asval/builder/geometry_view.h"
+
+namespace asval {
+
+// One block of layer-owned memory that the device copies build inputs into and the host reads.
+struct CaptureSlab {
+  VkBuffer buffer = VK_NULL_HANDLE;  // TRANSFER_DST
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  const uint8_t* mapped = nullptr;  // host-visible, coherent, mapped for the slab's lifetime
+  VkDeviceSize size = 0;
+};
+
+// Where slabs come from and go back to (layer/capture's pool; destroyed with the device).
+class CaptureSlabOwner {
+ public:
+  virtual ~CaptureSlabOwner() = default;
+  virtual void Return(const CaptureSlab& slab) = 0;
+};
+
+// A range of captured bytes in the log's slabs; size 0 with present: nothing to read (no primitives).
+struct CapturedBytes {
+  uint32_t slab = 0;
+  VkDeviceSize offset = 0;
+  VkDeviceSize size = 0;
+  bool present = false;  // false: not captured (no buffer the layer could copy from)
+};
+
+// One geometry as the builder reads it: the geometry's parameters with every offset the copy already applied
+// removed (the captured bytes start where the build starts reading), and the bytes.
+struct CapturedGeometry {
+  VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  VkFormat vertex_format = VK_FORMAT_UNDEFINED;
+  VkDeviceSize vertex_stride = 0;
+  uint32_t max_vertex = 0;
+  VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
+  VkDeviceSize aabb_stride = 0;
+  builder::BuildRange range;  // primitiveCount, and the offsets still to apply to the captured bytes
+  CapturedBytes data;         // vertices (triangles) or AABB records
+  CapturedBytes indices;      // indexed triangles
+};
+
+// One captured build info (pInfos[i] of a recorded build command).
+struct CapturedInfo {
+  uint32_t first_geometry = 0;  // into CaptureLog::geometries
+  uint32_t geometry_count = 0;
+  // Every geometry's bytes are captured (else the info's activity is unknown: counted, never guessed).
+  bool complete = true;
+};
+
+class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
+ public:
+  explicit CaptureLog(std::shared_ptr<CaptureSlabOwner> owner) : owner_(std::move(owner)) {}
+  ~CaptureLog() {
+    for (const CaptureSlab& slab : slabs) owner_->Return(slab);
+  }
+  CaptureLog(const CaptureLog&) = delete;
+  CaptureLog& operator=(const CaptureLog&) = delete;
+
+  const uint8_t* Bytes(const CapturedBytes& bytes) const { return slabs[bytes.slab].mapped + bytes.offset; }
+
+  std::vector<CaptureSlab> slabs;
+  VkDeviceSize used_in_last_slab = 0;
+  VkDeviceSize bytes_captured = 0;
+  std::vector<CapturedInfo> infos;
+  std::vector<CapturedGeometry> geometries;
+
+  // Submissions of this recording not yet processed (CaptureTracker, under its lock). A second one while the
+  // first is pending (a SIMULTANEOUS_USE command buffer) makes the device write the same bytes twice before the
+  // layer reads them: every capture of the recording is then unknown until none is pending.
+  uint32_t pending_submissions = 0;
+  bool overlapped = false;
+
+ private:
+  std::shared_ptr<CaptureSlabOwner> owner_;
+};
+
+}  // namespace asval
