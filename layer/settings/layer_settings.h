@@ -21,6 +21,10 @@ enum LayerSettingFlagBits : uint32_t {
 #include "asval_settings_defs.inc"
 };
 
+// The type of each ENUM setting, its enumerators numbered from 0 in the manifest's order.
+#define ASVAL_SETTING_ENUM_TYPE(cpp_type, ...) enum cpp_type : uint32_t { __VA_ARGS__ };
+#include "asval_settings_defs.inc"
+
 // "VK_LAYER_ASVAL_as_validation": the pLayerName that VkLayerSettingsCreateInfoEXT entries must carry.
 inline constexpr const char kLayerName[] =
 #define ASVAL_SETTINGS_LAYER_NAME(name) name
@@ -39,6 +43,7 @@ struct LayerSettings {
 #define ASVAL_SETTING_BOOL(key, default_value, default_text) bool key = default_value;
 #define ASVAL_SETTING_STRING(key, default_value, default_text) std::string key = default_value;
 #define ASVAL_SETTING_LIST(key, default_value, default_text) std::vector<std::string> key = default_value;
+#define ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text) cpp_type key = default_value;
 #include "asval_settings_defs.inc"
 
   bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
@@ -52,6 +57,7 @@ struct LayerSettings {
 #define ASVAL_SETTING_BOOL(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_STRING(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_LIST(key, ...) same = same && a.key == b.key;
+#define ASVAL_SETTING_ENUM(key, ...) same = same && a.key == b.key;
 #include "asval_settings_defs.inc"
     return same;
   }

@@ -27,6 +27,7 @@ constexpr DefaultText kDefaultTexts[] = {
 #define ASVAL_SETTING_BOOL(key, default_value, default_text) {#key, default_text},
 #define ASVAL_SETTING_STRING(key, default_value, default_text) {#key, default_text},
 #define ASVAL_SETTING_LIST(key, default_value, default_text) {#key, default_text},
+#define ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text) {#key, default_text},
 #include "asval_settings_defs.inc"
 };
 
