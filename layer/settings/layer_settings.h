@@ -21,7 +21,8 @@ enum LayerSettingFlagBits : uint32_t {
 #include "asval_settings_defs.inc"
 };
 
-// The type of each ENUM setting, its enumerators numbered from 0 in the manifest's order.
+// The type of each ENUM setting, its enumerators numbered from 0 in the manifest's order
+// (capture: CaptureMode, with kCaptureOff, kCaptureUpdates, kCaptureAll).
 #define ASVAL_SETTING_ENUM_TYPE(cpp_type, ...) enum cpp_type : uint32_t { __VA_ARGS__ };
 #include "asval_settings_defs.inc"
 
@@ -34,6 +35,8 @@ inline constexpr const char kLayerName[] =
 struct LayerSettings {
   // One field per setting, named after its key, initialised to the manifest default:
   //   uint32_t report_flags;                      LayerSettingFlagBits
+  //   CaptureMode capture;                        kCaptureOff, kCaptureUpdates or kCaptureAll
+  //   uint32_t capture_budget_mb;                 per submission, 1..65536
   //   uint32_t duplicate_message_limit;           0 = unlimited
   //   std::vector<std::string> message_id_filter; VUIDs, VUID suffixes or message-id hashes, as written
   //   std::string report_file;                    JSON-lines report path, empty = none
