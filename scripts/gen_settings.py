@@ -50,6 +50,7 @@ MACRO_FOR_TYPE = {
     "LOAD_FOLDER": "ASVAL_SETTING_STRING",
     "LIST": "ASVAL_SETTING_LIST",
     "FLAGS": "ASVAL_SETTING_FLAGS",
+    "ENUM": "ASVAL_SETTING_ENUM",
 }
 STRING_TYPES = {"STRING", "SAVE_FILE", "LOAD_FILE", "SAVE_FOLDER", "LOAD_FOLDER"}
 INT_CPP_TYPES = {"uint32_t": (0, 2**32 - 1), "int32_t": (-(2**31), 2**31 - 1)}
@@ -99,6 +100,29 @@ def check_ascii(text, where):
     require(all(32 <= ord(c) < 127 for c in text), f"{where} must be printable ASCII: {text!r}")
 
 
+def check_cpp_name(name, where, seen_cpp_names):
+    """A C++ identifier the .inc declares at namespace scope, so it must be unique."""
+    require(isinstance(name, str) and CPP_IDENTIFIER.match(name), f"{where} must be a C++ identifier")
+    require(name not in seen_cpp_names, f"{where}: C++ name {name} used twice")
+    seen_cpp_names.add(name)
+
+
+def check_flag_list(s, where, seen_cpp_names):
+    """The flags array of a FLAGS or ENUM setting (the vkconfig schema uses it for both); its keys."""
+    flags = s.get("flags")
+    require(isinstance(flags, list) and flags, f"{where}: {s['type']} needs a non-empty flags array")
+    flag_keys = set()
+    for f in flags:
+        fkey = f.get("key")
+        require(isinstance(fkey, str) and SNAKE_CASE.match(fkey), f"{where}: flag key {fkey!r} must be snake_case")
+        require(fkey not in flag_keys, f"{where}: duplicate flag {fkey}")
+        flag_keys.add(fkey)
+        for field in ("label", "description"):
+            check_ascii(f.get(field), f"{where}.flags.{fkey}.{field}")
+        check_cpp_name(f.get("cpp", {}).get("name"), f"{where}: flag {fkey} cpp.name", seen_cpp_names)
+    return flag_keys
+
+
 def check_setting(s, seen_keys, seen_cpp_names):
     key = s.get("key")
     require(isinstance(key, str) and SNAKE_CASE.match(key), f"setting key {key!r} must be snake_case")
@@ -129,25 +153,17 @@ def check_setting(s, seen_keys, seen_cpp_names):
             check_ascii(item, f"{where}.default item")
             require(item and "," not in item and "#" not in item, f"{where}: list item {item!r} cannot be written in a settings file")
     elif stype == "FLAGS":
-        flags = s.get("flags")
-        require(isinstance(flags, list) and flags, f"{where}: FLAGS needs a non-empty flags array")
-        require(len(flags) <= 32, f"{where}: at most 32 flags fit the uint32_t bitmask")
-        flag_keys = set()
-        for f in flags:
-            fkey = f.get("key")
-            require(isinstance(fkey, str) and SNAKE_CASE.match(fkey), f"{where}: flag key {fkey!r} must be snake_case")
-            require(fkey not in flag_keys, f"{where}: duplicate flag {fkey}")
-            flag_keys.add(fkey)
-            for field in ("label", "description"):
-                check_ascii(f.get(field), f"{where}.flags.{fkey}.{field}")
-            cpp_name = f.get("cpp", {}).get("name")
-            require(isinstance(cpp_name, str) and CPP_IDENTIFIER.match(cpp_name),
-                    f"{where}: flag {fkey} needs cpp.name, a C++ identifier")
-            require(cpp_name not in seen_cpp_names, f"{where}: C++ name {cpp_name} used twice")
-            seen_cpp_names.add(cpp_name)
+        flag_keys = check_flag_list(s, where, seen_cpp_names)
+        require(len(flag_keys) <= 32, f"{where}: at most 32 flags fit the uint32_t bitmask")
         require(isinstance(default, list) and all(d in flag_keys for d in default),
                 f"{where}: FLAGS default must be an array of its flag keys")
         require(len(set(default)) == len(default), f"{where}: FLAGS default repeats a flag")
+    elif stype == "ENUM":
+        # The C++ side declares `enum <cpp.type> : uint32_t` with one enumerator per flag, in order.
+        check_cpp_name(s.get("cpp", {}).get("type"), f"{where}: cpp.type", seen_cpp_names)
+        flag_keys = check_flag_list(s, where, seen_cpp_names)
+        require(isinstance(default, str) and default in flag_keys,
+                f"{where}: ENUM default must be one of its flag keys")
 
 
 def check_source(src):
@@ -248,13 +264,19 @@ def render_defs(src):
         "//   ASVAL_SETTING_BOOL(key, default_value, default_text)",
         "//   ASVAL_SETTING_STRING(key, default_value, default_text)",
         "//   ASVAL_SETTING_LIST(key, default_value, default_text)",
-        "// key/setting: the snake_case setting name as a bare identifier; flag: a string literal;",
+        "//   ASVAL_SETTING_ENUM_TYPE(cpp_type, cpp_names...)           the C++ type of an ENUM setting and",
+        "//                                                             its enumerators, in value order from 0",
+        "//   ASVAL_SETTING_ENUM_VALUE(setting, value, cpp_name)        one value of an ENUM setting; listed",
+        "//                                                             before the setting it belongs to",
+        "//   ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text)",
+        "// key/setting: the snake_case setting name as a bare identifier; flag, value: string literals;",
         "// default_value: a parenthesised C++ expression; default_text: the default spelled the way",
-        "// vk_layer_settings.txt spells it. FLAGS defaults use the ASVAL_SETTING_FLAG cpp_names, so",
-        "// those must be in scope where defaults are expanded.",
+        "// vk_layer_settings.txt spells it. FLAGS and ENUM defaults use the ASVAL_SETTING_FLAG and",
+        "// ASVAL_SETTING_ENUM_TYPE cpp_names, so those must be in scope where defaults are expanded.",
         "",
     ]
-    macros = ["ASVAL_SETTINGS_LAYER_NAME", "ASVAL_SETTING_FLAG"] + sorted(set(MACRO_FOR_TYPE.values()))
+    macros = (["ASVAL_SETTINGS_LAYER_NAME", "ASVAL_SETTING_FLAG", "ASVAL_SETTING_ENUM_TYPE", "ASVAL_SETTING_ENUM_VALUE"]
+              + sorted(set(MACRO_FOR_TYPE.values())))
     for m in macros:
         lines += [f"#ifndef {m}", f"#define {m}(...)", "#endif"]
     lines += ["", f"ASVAL_SETTINGS_LAYER_NAME({c_string(src['layer']['name'])})", ""]
@@ -268,6 +290,12 @@ def render_defs(src):
                 lines.append(f"ASVAL_SETTING_FLAG({key}, {c_string(f['key'])}, {f['cpp']['name']}, 0x{1 << bit:x}u)")
             bits = " | ".join(names[k] for k in d) if d else "0u"
             lines.append(f"ASVAL_SETTING_FLAGS({key}, ({bits}), {text})")
+        elif stype == "ENUM":
+            cpp_type, names = s["cpp"]["type"], {f["key"]: f["cpp"]["name"] for f in s["flags"]}
+            lines.append(f"ASVAL_SETTING_ENUM_TYPE({cpp_type}, {', '.join(names.values())})")
+            for value, cpp_name in names.items():
+                lines.append(f"ASVAL_SETTING_ENUM_VALUE({key}, {c_string(value)}, {cpp_name})")
+            lines.append(f"ASVAL_SETTING_ENUM({key}, {cpp_type}, ({names[d]}), {text})")
         elif stype == "INT":
             lo, hi = int_range(s)
             lines.append(f"ASVAL_SETTING_INT({key}, {s['cpp']['type']}, ({d}), ({lo}), ({hi}), {text})")
@@ -335,6 +363,10 @@ def render_sample(src):
         out += comment_block(s["description"])
         if s["type"] == "FLAGS":
             out.append("# Flags:")
+            for f in s["flags"]:
+                out += comment_block(f"  {f['key']}: {f['description']}")
+        if s["type"] == "ENUM":
+            out.append("# Values (exactly one):")
             for f in s["flags"]:
                 out += comment_block(f"  {f['key']}: {f['description']}")
         if s["type"] == "INT":

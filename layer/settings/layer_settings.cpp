@@ -14,6 +14,7 @@ namespace asval {
 namespace {
 
 using settings_detail::ApiSettingEntry;
+using settings_detail::EnumValueName;
 using settings_detail::FlagName;
 using settings_detail::RawSetting;
 using settings_detail::SettingsFileLocation;
@@ -22,6 +23,13 @@ using settings_detail::SettingsFileValues;
 // Every flag of every FLAGS setting; the empty last entry keeps the array valid if there were none.
 constexpr FlagName kFlagNames[] = {
 #define ASVAL_SETTING_FLAG(setting, flag, cpp_name, bit) {#setting, flag, bit},
+#include "asval_settings_defs.inc"
+    {"", "", 0},
+};
+
+// Every value of every ENUM setting, likewise.
+constexpr EnumValueName kEnumValueNames[] = {
+#define ASVAL_SETTING_ENUM_VALUE(setting, value, cpp_name) {#setting, value, cpp_name},
 #include "asval_settings_defs.inc"
     {"", "", 0},
 };
@@ -55,6 +63,10 @@ const SettingHandler kHandlers[] = {
 #define ASVAL_SETTING_LIST(key, default_value, default_text)                             \
   {#key, default_text, [](const RawSetting& raw, LayerSettings* s, std::string* error) { \
      return settings_detail::ReadList(raw, &s->key, error);                              \
+   }},
+#define ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text)                                               \
+  {#key, default_text, [](const RawSetting& raw, LayerSettings* s, std::string* error) {                             \
+     return settings_detail::ReadEnumAs(raw, #key, kEnumValueNames, std::size(kEnumValueNames), &s->key, error); \
    }},
 #include "asval_settings_defs.inc"
 };

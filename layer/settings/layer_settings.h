@@ -21,6 +21,11 @@ enum LayerSettingFlagBits : uint32_t {
 #include "asval_settings_defs.inc"
 };
 
+// The type of each ENUM setting, its enumerators numbered from 0 in the manifest's order
+// (capture: CaptureMode, with kCaptureOff, kCaptureUpdates, kCaptureAll).
+#define ASVAL_SETTING_ENUM_TYPE(cpp_type, ...) enum cpp_type : uint32_t { __VA_ARGS__ };
+#include "asval_settings_defs.inc"
+
 // "VK_LAYER_ASVAL_as_validation": the pLayerName that VkLayerSettingsCreateInfoEXT entries must carry.
 inline constexpr const char kLayerName[] =
 #define ASVAL_SETTINGS_LAYER_NAME(name) name
@@ -30,6 +35,8 @@ inline constexpr const char kLayerName[] =
 struct LayerSettings {
   // One field per setting, named after its key, initialised to the manifest default:
   //   uint32_t report_flags;                      LayerSettingFlagBits
+  //   CaptureMode capture;                        kCaptureOff, kCaptureUpdates or kCaptureAll
+  //   uint32_t capture_budget_mb;                 per submission, 1..65536
   //   uint32_t duplicate_message_limit;           0 = unlimited
   //   std::vector<std::string> message_id_filter; VUIDs, VUID suffixes or message-id hashes, as written
   //   std::string report_file;                    JSON-lines report path, empty = none
@@ -39,6 +46,7 @@ struct LayerSettings {
 #define ASVAL_SETTING_BOOL(key, default_value, default_text) bool key = default_value;
 #define ASVAL_SETTING_STRING(key, default_value, default_text) std::string key = default_value;
 #define ASVAL_SETTING_LIST(key, default_value, default_text) std::vector<std::string> key = default_value;
+#define ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text) cpp_type key = default_value;
 #include "asval_settings_defs.inc"
 
   bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
@@ -52,6 +60,7 @@ struct LayerSettings {
 #define ASVAL_SETTING_BOOL(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_STRING(key, ...) same = same && a.key == b.key;
 #define ASVAL_SETTING_LIST(key, ...) same = same && a.key == b.key;
+#define ASVAL_SETTING_ENUM(key, ...) same = same && a.key == b.key;
 #include "asval_settings_defs.inc"
     return same;
   }

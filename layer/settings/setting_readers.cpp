@@ -222,4 +222,30 @@ bool ReadFlags(const RawSetting& raw, const char* setting, const FlagName* flags
   return true;
 }
 
+bool ReadEnum(const RawSetting& raw, const char* setting, const EnumValueName* values, size_t value_count,
+              uint32_t* out, std::string* error) {
+  std::string text = raw.text;
+  if (raw.api != nullptr) {
+    const VkLayerSettingEXT& entry = *raw.api;
+    if (!CheckSingleValue(entry, error)) return false;
+    if (entry.type != VK_LAYER_SETTING_TYPE_STRING_EXT) {
+      return WrongType(entry, "one STRING value (a value name)", error);
+    }
+    if (!ApiSingleString(entry, &text, error)) return false;
+  }
+  // Trimmed like a flag name, so that "updates " from the environment reads as it does from the file.
+  const std::string_view name = TrimWhitespace(text);
+  std::string valid;
+  for (size_t i = 0; i < value_count; ++i) {
+    if (std::string_view(values[i].setting) != setting) continue;
+    if (name == values[i].value) {
+      *out = values[i].index;
+      return true;
+    }
+    valid += valid.empty() ? "" : ", ";
+    valid += values[i].value;
+  }
+  return Fail(error, "'" + std::string(name) + "' is not one of its values (" + valid + ")");
+}
+
 }  // namespace asval::settings_detail

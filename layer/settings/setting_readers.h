@@ -8,10 +8,12 @@
 //   LIST          STRING (each value one item, verbatim), or INT32/UINT32/INT64/UINT64 written in
 //                 decimal, as VUL converts them for string lists
 //   FLAGS         STRING, each value one flag name
+//   ENUM          STRING, one value, the name of one of its values
 // Beyond VUL (which rejects a type mismatch), BOOL and INT also take one STRING value parsed like
 // text, so an application can pass every setting as a string, as it would write it in the file.
 // Text values: BOOL and INT per setting_text.h; STRING verbatim (never split: it may be a path with
-// ':'); LIST and FLAGS split per SplitList.
+// ':'); LIST and FLAGS split per SplitList; ENUM whitespace-trimmed, never split. FLAGS and ENUM names
+// are case-sensitive, as in vkconfig's manifest.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +46,17 @@ bool ReadList(const RawSetting& raw, std::vector<std::string>* out, std::string*
 bool ReadFlags(const RawSetting& raw, const char* setting, const FlagName* flags, size_t flag_count, uint32_t* out,
                std::string* error);
 
+// Name and index of one value of an ENUM setting.
+struct EnumValueName {
+  const char* setting;
+  const char* value;
+  uint32_t index;
+};
+
+// `values` lists every value of every ENUM setting; only those whose .setting equals `setting` apply.
+bool ReadEnum(const RawSetting& raw, const char* setting, const EnumValueName* values, size_t value_count,
+              uint32_t* out, std::string* error);
+
 // Checks pValues/valueCount/type of an API entry without interpreting it; "" when usable.
 std::string DescribeApiEntryProblem(const VkLayerSettingEXT& entry);
 
@@ -53,6 +66,16 @@ bool ReadIntegerAs(const RawSetting& raw, int64_t min, int64_t max, Int* out, st
   int64_t value = 0;
   if (!ReadInteger(raw, min, max, &value, error)) return false;
   *out = static_cast<Int>(value);
+  return true;
+}
+
+// Same for the generated enum type of one ENUM setting.
+template <typename Enum>
+bool ReadEnumAs(const RawSetting& raw, const char* setting, const EnumValueName* values, size_t value_count,
+                Enum* out, std::string* error) {
+  uint32_t index = 0;
+  if (!ReadEnum(raw, setting, values, value_count, &index, error)) return false;
+  *out = static_cast<Enum>(index);
   return true;
 }
 

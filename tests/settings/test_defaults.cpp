@@ -5,6 +5,7 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <type_traits>
 
 #include "settings_file.h"
 #include "settings_test_support.h"
@@ -27,6 +28,7 @@ constexpr DefaultText kDefaultTexts[] = {
 #define ASVAL_SETTING_BOOL(key, default_value, default_text) {#key, default_text},
 #define ASVAL_SETTING_STRING(key, default_value, default_text) {#key, default_text},
 #define ASVAL_SETTING_LIST(key, default_value, default_text) {#key, default_text},
+#define ASVAL_SETTING_ENUM(key, cpp_type, default_value, default_text) {#key, default_text},
 #include "asval_settings_defs.inc"
 };
 
@@ -48,6 +50,8 @@ std::string ReadRepoSample() {
 TEST_CASE("default values are the ones the layer documents", "[settings][defaults]") {
   const LayerSettings s;
   CHECK(s.report_flags == (kSeverityError | kSeverityWarn));
+  CHECK(s.capture == kCaptureUpdates);
+  CHECK(s.capture_budget_mb == 256u);
   CHECK(s.duplicate_message_limit == 10u);
   CHECK(s.message_id_filter.empty());
   CHECK(s.report_file.empty());
@@ -55,6 +59,11 @@ TEST_CASE("default values are the ones the layer documents", "[settings][default
   CHECK(kSeverityError == 1u);
   CHECK(kSeverityWarn == 2u);
   CHECK(kSeverityInfo == 4u);
+  // ENUM settings have their own type, its enumerators numbered in the manifest's order.
+  STATIC_CHECK(std::is_same_v<decltype(s.capture), CaptureMode>);
+  CHECK(kCaptureOff == 0u);
+  CHECK(kCaptureUpdates == 1u);
+  CHECK(kCaptureAll == 2u);
 }
 
 TEST_CASE("each default text reads back as the typed default", "[settings][defaults]") {

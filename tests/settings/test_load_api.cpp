@@ -58,6 +58,12 @@ TEST_CASE("API values of each accepted type", "[settings][api]") {
   CHECK(LoadOne(Entry("report_flags", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, flags), &warnings).report_flags ==
         (kSeverityWarn | kSeverityInfo));
 
+  const char* capture = "all";
+  CHECK(LoadOne(Entry("capture", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &capture), &warnings).capture == kCaptureAll);
+  const uint32_t budget = 1024;
+  CHECK(LoadOne(Entry("capture_budget_mb", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &budget), &warnings)
+            .capture_budget_mb == 1024);
+
   const char* filters[] = {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710", "03667"};
   CHECK(
       LoadOne(Entry("message_id_filter", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, filters), &warnings).message_id_filter ==
@@ -93,6 +99,9 @@ TEST_CASE("API values of a wrong type give a warning and keep the default", "[se
            Case{Entry("report_flags", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &one), "VK_LAYER_SETTING_TYPE_UINT32_EXT"},
            Case{Entry("message_id_filter", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &yes),
                 "VK_LAYER_SETTING_TYPE_BOOL32_EXT"},
+           // An ENUM takes its value name as a string, never an index.
+           Case{Entry("capture", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &one), "VK_LAYER_SETTING_TYPE_UINT32_EXT"},
+           Case{Entry("capture", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &yes), "VK_LAYER_SETTING_TYPE_BOOL32_EXT"},
        }) {
     CAPTURE(c.entry.pSettingName, c.expect);
     std::vector<std::string> warnings;
@@ -112,6 +121,9 @@ TEST_CASE("malformed API entries give a warning and are ignored", "[settings][ap
   const char* maybe = "maybe";
   const char* many = "many";
   const char* minus = "-3";
+  const char* capture_names[] = {"off", "all"};
+  const char* upper_all = "ALL";
+  const uint32_t no_budget = 0;
   struct Case {
     VkLayerSettingEXT entry;
     const char* expect;
@@ -142,6 +154,12 @@ TEST_CASE("malformed API entries give a warning and are ignored", "[settings][ap
            Case{Entry("message_id_filter", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, null_string),
                 "NULL string at pValues[1]"},
            Case{Entry("message_id_filter", VK_LAYER_SETTING_TYPE_STRING_EXT, 0, nullptr), "valueCount 0"},
+           Case{Entry("capture", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &upper_all), "'ALL' is not one of its values"},
+           Case{Entry("capture", VK_LAYER_SETTING_TYPE_STRING_EXT, 2, capture_names),
+                "valueCount 2; this setting takes one value"},
+           Case{Entry("capture", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &null_string[1]), "NULL string at pValues[0]"},
+           Case{Entry("capture_budget_mb", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, &no_budget),
+                "0 is outside the range 1..65536"},
            Case{Entry("no_such_setting", VK_LAYER_SETTING_TYPE_UINT32_EXT, 1, two_values),
                 "unknown setting 'no_such_setting' for VK_LAYER_ASVAL_as_validation"},
        }) {

@@ -41,6 +41,22 @@ TEST_CASE("report_flags takes a list of flag names", "[settings][values]") {
   CHECK_FALSE(s.Reports(kSeverityWarn));
 }
 
+TEST_CASE("capture takes one of its value names", "[settings][values][enum]") {
+  std::vector<std::string> warnings;
+  CHECK(LoadFile("asval_as_validation.capture = off\n", &warnings).capture == kCaptureOff);
+  CHECK(LoadFile("asval_as_validation.capture = all\n", &warnings).capture == kCaptureAll);
+  CHECK(LoadEnv("VK_ASVAL_AS_VALIDATION_CAPTURE", "all", &warnings).capture == kCaptureAll);
+  CHECK(LoadEnv("VK_CAPTURE", " off ", &warnings).capture == kCaptureOff);  // trimmed, like a flag name
+  CHECK(warnings.empty());
+
+  // The environment beats the file, as for every other type.
+  FakeSources fake;
+  fake.env["VK_AS_VALIDATION_CAPTURE"] = "off";
+  WriteFile(fake.Cwd() / "vk_layer_settings.txt", "asval_as_validation.capture = all\n");
+  CHECK(LoadLayerSettings(fake.Get(), nullptr, &warnings).capture == kCaptureOff);
+  CHECK(warnings.empty());
+}
+
 TEST_CASE("message_id_filter splits on ',' if present, else on ':'", "[settings][values]") {
   std::vector<std::string> warnings;
   CHECK(
@@ -82,6 +98,8 @@ TEST_CASE("integers: decimal and 0x hexadecimal, within the range", "[settings][
   CHECK(LoadFile("asval_as_validation.duplicate_message_limit = 0\n", &warnings).duplicate_message_limit == 0);
   CHECK(LoadFile("asval_as_validation.duplicate_message_limit = 0x10\n", &warnings).duplicate_message_limit == 16);
   CHECK(LoadEnv("VK_DUPLICATE_MESSAGE_LIMIT", "4294967295", &warnings).duplicate_message_limit == 4294967295u);
+  CHECK(LoadFile("asval_as_validation.capture_budget_mb = 1\n", &warnings).capture_budget_mb == 1);
+  CHECK(LoadEnv("VK_CAPTURE_BUDGET_MB", "65536", &warnings).capture_budget_mb == 65536);
   CHECK(warnings.empty());
 }
 
@@ -99,6 +117,12 @@ TEST_CASE("malformed values give a warning and keep the default", "[settings][va
            Case{"asval_as_validation.report_flags = error,bogus",
                 "'bogus' is not one of its flags (error, warn, info)"},
            Case{"asval_as_validation.report_flags = Error", "'Error' is not one of its flags"},
+           Case{"asval_as_validation.capture = everything",
+                "'everything' is not one of its values (off, updates, all)"},
+           Case{"asval_as_validation.capture = All", "'All' is not one of its values"},  // case-sensitive
+           Case{"asval_as_validation.capture = off,all", "'off,all' is not one of its values"},  // exactly one
+           Case{"asval_as_validation.capture_budget_mb = 0", "outside the range 1..65536"},
+           Case{"asval_as_validation.capture_budget_mb = 65537", "outside the range 1..65536"},
        }) {
     CAPTURE(c.line);
     std::vector<std::string> warnings;
@@ -117,6 +141,17 @@ TEST_CASE("a malformed environment value does not fall back to the file", "[sett
   REQUIRE(warnings.size() == 1);
   CHECK(HasWarning(warnings, "environment variable VK_AS_VALIDATION_DUPLICATE_MESSAGE_LIMIT", "'lots'",
                    "duplicate_message_limit keeps its default (10)"));
+}
+
+TEST_CASE("an unknown capture value from the environment keeps the default", "[settings][values][malformed][enum]") {
+  FakeSources fake;
+  fake.env["VK_CAPTURE"] = "updates-only";
+  WriteFile(fake.Cwd() / "vk_layer_settings.txt", "asval_as_validation.capture = all\n");
+  std::vector<std::string> warnings;
+  CHECK(LoadLayerSettings(fake.Get(), nullptr, &warnings).capture == kCaptureUpdates);
+  REQUIRE(warnings.size() == 1);
+  CHECK(HasWarning(warnings, "environment variable VK_CAPTURE", "'updates-only' is not one of its values",
+                   "capture keeps its default (updates)"));
 }
 
 TEST_CASE("unknown keys of this layer in the file give a warning; other layers' keys do not",
