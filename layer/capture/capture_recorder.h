@@ -16,11 +16,10 @@
 
 #include "capture_pool.h"
 #include "device_state.h"
+#include "layer_settings.h"
 #include "vk_dispatch_table.h"
 
 namespace asval {
-
-enum class CaptureMode : uint8_t { kOff, kUpdates, kAll };
 
 struct CaptureCounters {
   std::atomic<uint64_t> infos_captured{0};
@@ -41,8 +40,8 @@ struct CaptureContext {
 
 // Whether a build info needs its inputs captured (cheap: the hot path of builds that need none).
 inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeometryInfoKHR& info) {
-  if (mode == CaptureMode::kOff || info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
-  return mode == CaptureMode::kAll || info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
+  if (mode == kCaptureOff || info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
+  return mode == kCaptureAll || info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
          (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
 }
 

@@ -37,7 +37,7 @@ struct DeviceData {
   DeviceState state;
   // Execution-time capture (layer/capture): null when the capture setting is off or the history is not tracked.
   // The tracker is destroyed before the pool (declaration order).
-  CaptureMode capture_mode = CaptureMode::kOff;
+  CaptureMode capture_mode = kCaptureOff;
   VkDeviceSize capture_budget = 0;
   CaptureCounters capture_counters;
   std::shared_ptr<CapturePool> capture_pool;
