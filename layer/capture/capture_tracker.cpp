@@ -35,24 +35,40 @@ VkFence CaptureTracker::TakeFence() {
   return fence;
 }
 
+void CaptureTracker::Reserve(const SubmissionCaptures& captures) {
+  std::lock_guard<std::recursive_mutex> order(processing_);
+  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
+    // Pending twice: the device writes the same capture bytes twice before they are read.
+    if (log->pending_submissions > 0) log->overlapped = true;
+    ++log->pending_submissions;
+  }
+}
+
+void CaptureTracker::Unreserve(const SubmissionCaptures& captures) {
+  std::lock_guard<std::recursive_mutex> order(processing_);
+  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
+    if (--log->pending_submissions == 0) log->overlapped = false;
+  }
+}
+
 void CaptureTracker::Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures) {
-  if (captures.empty()) return;
   const VkFence fence = TakeFence();
   // Without a fence of its own the layer cannot know when the bytes are there: nothing is read (unknown).
   if (!fence || next_.QueueSubmit(queue, 0, nullptr, fence) != VK_SUCCESS) {
-    for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
+    {
+      std::lock_guard<std::recursive_mutex> order(processing_);
+      for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
+    }
+    Unreserve(captures);
     if (fence) next_.DestroyFence(device_, fence, nullptr);
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
-    // Pending twice (SIMULTANEOUS_USE): the device writes the same capture bytes twice before they are read.
-    if (log->pending_submissions > 0) log->overlapped = true;
-    ++log->pending_submissions;
-  }
   pending_.push_back(Pending{queue, app_fence, fence, std::move(captures)});
+  pending_count_.fetch_add(1, std::memory_order_release);
 }
 
+// With the processing lock held.
 void CaptureTracker::Retire(Pending& p) {
   for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) {
     if (--log->pending_submissions == 0) log->overlapped = false;
@@ -93,6 +109,7 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       if (status != VK_SUCCESS) break;  // still pending (or the device was lost): later, in order
       current = std::move(p);
       pending_.pop_front();
+      pending_count_.fetch_sub(1, std::memory_order_release);
     }
     on_complete(current.captures);
     std::lock_guard<std::mutex> lock(mutex_);
@@ -101,9 +118,5 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
   t_processing = false;
 }
 
-bool CaptureTracker::idle() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return pending_.empty();
-}
 
 }  // namespace asval

@@ -11,6 +11,7 @@
 // no device feature the app may not have enabled and leaves the app's submission as it was.
 #include <vulkan/vulkan.h>
 
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -36,13 +37,21 @@ class CaptureTracker {
   CaptureTracker(VkDevice device, const DeviceDispatchTable& next) : device_(device), next_(next) {}
   ~CaptureTracker();
 
-  // A submission to `queue` (with the app's fence, or null) succeeded and carries captures.
+  // Before the downcall of a submission that carries captures: its recordings count as pending from now on, so
+  // that one already pending (a SIMULTANEOUS_USE command buffer, or one whose completion the layer has not seen
+  // yet) is marked overlapped before the device can write its capture bytes again, and no reader is reading them
+  // meanwhile (both under the processing lock).
+  void Reserve(const SubmissionCaptures& captures);
+  // The submission was not made (skipped, or rejected by the driver).
+  void Unreserve(const SubmissionCaptures& captures);
+  // It succeeded: the layer's fence follows it on `queue` (the app's fence, or null, names it for the waits).
   void Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures);
   // Processes, in submission order, every submission that completed, and those `covered` names (waiting for
   // their layer fence); stops at the first one still pending. A call made while this thread is processing (from
   // an app callback) does nothing.
   void Process(const Covered& covered, const OnComplete& on_complete);
-  bool idle() const;
+  // No submission pending (one relaxed load: asked at every submission and wait).
+  bool idle() const { return pending_count_.load(std::memory_order_acquire) == 0; }
 
  private:
   struct Pending {
@@ -57,8 +66,10 @@ class CaptureTracker {
   const VkDevice device_;
   const DeviceDispatchTable& next_;
   mutable std::mutex mutex_;          // pending_, free_fences_
-  std::recursive_mutex processing_;  // one thread processes at a time, in order
+  // One thread processes at a time, in order; also guards the logs' pending_submissions and overlapped.
+  std::recursive_mutex processing_;
   std::deque<Pending> pending_;
+  std::atomic<std::size_t> pending_count_{0};
   std::vector<VkFence> free_fences_;
 };
 

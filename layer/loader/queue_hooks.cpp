@@ -29,10 +29,14 @@ VkResult Submit(DeviceData& data, VkQueue queue, VkFence fence, ForEachCommandBu
     submission.Undo();
     return VK_ERROR_VALIDATION_FAILED_EXT;
   }
+  // Pre-record: the recordings whose captures run now count as pending before the device may write them.
+  const bool captures = data.capture_tracker && !submission.captures().empty();
+  if (captures) data.capture_tracker->Reserve(submission.captures());
   const VkResult result = downcall();
   if (result != VK_SUCCESS) {
+    if (captures) data.capture_tracker->Unreserve(submission.captures());
     submission.Undo();
-  } else if (data.capture_tracker && !submission.captures().empty()) {
+  } else if (captures) {
     data.capture_tracker->Track(queue, fence, std::move(submission.captures()));
   }
   return result;

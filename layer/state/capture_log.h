@@ -79,7 +79,8 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   std::vector<CapturedInfo> infos;
   std::vector<CapturedGeometry> geometries;
 
-  // Submissions of this recording not yet processed (CaptureTracker, under its lock). A second one while the
+  // Submissions of this recording not yet processed (CaptureTracker, under its processing lock, which the readers
+  // of the bytes hold too). A second one while the
   // first is pending (a SIMULTANEOUS_USE command buffer) makes the device write the same bytes twice before the
   // layer reads them: every capture of the recording is then unknown until none is pending.
   uint32_t pending_submissions = 0;
