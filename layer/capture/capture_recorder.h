@@ -21,14 +21,6 @@
 
 namespace asval {
 
-struct CaptureCounters {
-  std::atomic<uint64_t> infos_captured{0};
-  std::atomic<uint64_t> bytes_captured{0};
-  // Infos a rule needed but that could not be captured (no copyable buffer, over the budget, a geometry kind
-  // or format not captured yet, no host-visible memory).
-  std::atomic<uint64_t> infos_not_captured{0};
-};
-
 struct CaptureContext {
   const DeviceState& state;
   const DeviceDispatchTable& next;

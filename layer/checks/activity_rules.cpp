@@ -57,6 +57,7 @@ void CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& c) {
     ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
     return;
   }
+  ctx.state.capture_counters.updates_compared.fetch_add(1, std::memory_order_relaxed);
   const auto& before = c.before->geometries();
   const auto& after = c.after->geometries();
   // A different geometry count is its own rule (pInfos-03758): the geometries both have are compared.

@@ -31,6 +31,19 @@ bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd) {
 void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
   const HistoryStore& store = state.history.store;
   const uint64_t skipped = store.rules_skipped_unknown_history.load(std::memory_order_relaxed);
+  const CaptureCounters& capture = state.capture_counters;
+  const uint64_t not_captured = capture.infos_not_captured.load(std::memory_order_relaxed);
+  if (not_captured != 0 || capture.infos_captured.load(std::memory_order_relaxed) != 0) {
+    reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
+                    {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+                    fmt::format("Execution-time capture: {} build infos captured ({} bytes), {} updates judged on "
+                                "their captured activity; {} infos that a rule needed could not be captured (their "
+                                "rules were skipped and counted: a geometry kind or format not captured yet, a "
+                                "buffer the layer could not copy, or over capture_budget_mb).",
+                                capture.infos_captured.load(std::memory_order_relaxed),
+                                capture.bytes_captured.load(std::memory_order_relaxed),
+                                capture.updates_compared.load(std::memory_order_relaxed), not_captured));
+  }
   if (skipped == 0) return;
   reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                   {Obj(VK_OBJECT_TYPE_DEVICE, device)},

@@ -39,7 +39,6 @@ struct DeviceData {
   // The tracker is destroyed before the pool (declaration order).
   CaptureMode capture_mode = kCaptureOff;
   VkDeviceSize capture_budget = 0;
-  CaptureCounters capture_counters;
   std::shared_ptr<CapturePool> capture_pool;
   std::unique_ptr<CaptureTracker> capture_tracker;
 };
@@ -47,7 +46,7 @@ struct DeviceData {
 // What the capture's pre-record of a build sees.
 inline CaptureContext MakeCaptureContext(DeviceData& data) {
   return CaptureContext{data.state, data.dispatch, *data.capture_pool, data.capture_mode, data.capture_budget,
-                        data.capture_counters};
+                        data.state.capture_counters};
 }
 
 // Processes the submissions with captures that completed (or that `covered` names: the app's wait saw them

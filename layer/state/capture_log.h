@@ -9,6 +9,7 @@
 // processing lock (CaptureTracker, layer/capture).
 #include <vulkan/vulkan.h>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -16,6 +17,17 @@
 #include "asval/builder/geometry_view.h"
 
 namespace asval {
+
+// What the capture did on a device (DeviceState::capture_counters; shown in the history summary).
+struct CaptureCounters {
+  std::atomic<uint64_t> infos_captured{0};
+  std::atomic<uint64_t> bytes_captured{0};
+  // Infos a rule needed but that could not be captured (no copyable buffer, over the budget, a geometry kind
+  // or format not captured yet, no host-visible memory).
+  std::atomic<uint64_t> infos_not_captured{0};
+  // Updates whose activity rules (03663/03664/03768) were judged on captured bytes.
+  std::atomic<uint64_t> updates_compared{0};
+};
 
 // One block of layer-owned memory that the device copies build inputs into and the host reads.
 struct CaptureSlab {

@@ -62,6 +62,8 @@ class DeviceState {
   // Buffer format features, asked of the driver once per format (vertexFormat-03797).
   FormatFeatureCache format_features;
 
+  // Execution-time capture (layer/capture): what it captured, and could not.
+  mutable CaptureCounters capture_counters;
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
