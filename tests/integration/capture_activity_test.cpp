@@ -460,6 +460,29 @@ TEST_CASE("capture: primitives are counted from the build range's primitiveOffse
   }
 }
 
+TEST_CASE("capture: each geometry of an update is compared with the same geometry of its source",
+          "[integration][capture]") {
+  // The helpers' geometries all read the same vertices: one NaN makes primitive 1 of each inactive.
+  HistoryFixture f;
+  Rig rig(f);
+  Shape shape = Triangles();
+  shape.geometries = 3;
+  BuildTriangles(rig);  // writes the vertices (the build's shape is rebuilt below)
+  rig.Run(rig.Record([&](VkCommandBuffer cb) { rig.Build(cb, shape); }));
+  CHECK(f.monitor().Verify() == "");
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    rig.Fill(cb, Component(4, 0), kNan);
+    rig.Update(cb, shape);
+  }));
+  const std::vector<Message> messages = f.monitor().Take();
+  REQUIRE(messages.size() == 3);
+  for (uint32_t j = 0; j < 3; ++j) {
+    INFO(messages[j].text);
+    CHECK(messages[j].id_name == kBecameInactive);
+    CHECK(messages[j].text.find("geometry " + std::to_string(j) + ": 1 primitive(s)") != std::string::npos);
+  }
+}
+
 TEST_CASE("capture: an update recorded in a secondary command buffer is judged when the primary executes",
           "[integration][capture]") {
   HistoryFixture f;
@@ -610,6 +633,23 @@ TEST_CASE("capture: with capture=off, an update that makes a triangle inactive i
     rig.Update(cb, Triangles());
   }));
   CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("capture: with capture=all, an update that makes a triangle inactive is reported as by default",
+          "[integration][capture]") {
+  // `all` captures builds without ALLOW_UPDATE too; what an update is compared with is the same.
+  HistoryFixture f(nullptr, {{"capture", "all"}});
+  Rig rig(f);
+  Shape fixed = Triangles();
+  fixed.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  rig.Run(rig.Record([&](VkCommandBuffer cb) { rig.other().Build(cb, fixed); }));  // captured, never updated
+  BuildTriangles(rig);
+  CHECK(f.monitor().Verify() == "");
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    rig.Fill(cb, Component(4, 0), kNan);
+    rig.Update(cb, Triangles());
+  }));
+  CHECK(OnlyFinding(f.monitor(), kBecameInactive, ": primitive 1") == "");
 }
 
 }  // namespace
