@@ -121,10 +121,12 @@ void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vect
                               nullptr, 0, nullptr);
   for (const Copy& c : copies) ctx.next.CmdCopyBuffer(cb, c.src, c.dst, 1, &c.region);
   // The copies are visible to the host once the submission completes; later commands (writes of the inputs
-  // included) wait for the reads.
+  // included) wait for the reads. Later copies into the same capture bytes (a secondary command buffer executed
+  // twice, whose capture is then unknown anyway) are ordered after these writes too: without TRANSFER_WRITE
+  // here they would race with them (a write-after-write hazard that synchronization validation reports).
   VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  after.dstAccessMask = VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT,
                               VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after, 0, nullptr,
                               0, nullptr);

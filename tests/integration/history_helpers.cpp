@@ -74,7 +74,7 @@ VkCommandBuffer Commands::Begin() {
   return cb;
 }
 
-VkCommandBuffer Commands::BeginSecondary() {
+VkCommandBuffer Commands::BeginSecondary(VkCommandBufferUsageFlags flags) {
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = pool_;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_SECONDARY;
@@ -84,6 +84,7 @@ VkCommandBuffer Commands::BeginSecondary() {
   buffers_.push_back(cb);
   VkCommandBufferInheritanceInfo inheritance{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = flags;
   begin.pInheritanceInfo = &inheritance;
   vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
   return cb;
@@ -111,8 +112,8 @@ VkResult Commands::Submit(const std::vector<VkCommandBuffer>& cbs) {
 
 // ---- Inputs ----------------------------------------------------------------------------------------------------
 
-Inputs::Inputs(vkkit::Device& device) : device_(device) {
-  buffer_ = device.CreateBuffer(1024, kInputUsage);
+Inputs::Inputs(vkkit::Device& device, VkBufferUsageFlags extra_usage) : device_(device) {
+  buffer_ = device.CreateBuffer(1024, kInputUsage | extra_usage);
   auto* bytes = static_cast<unsigned char*>(buffer_.mapped);
   std::memset(bytes, 0, 1024);
   float vertices[kVertexCount * 3];
@@ -123,14 +124,14 @@ Inputs::Inputs(vkkit::Device& device) : device_(device) {
     vertices[3 * v + 1] = corner[v % 3][1];
     vertices[3 * v + 2] = static_cast<float>(v / 3);
   }
-  std::memcpy(bytes, vertices, sizeof(vertices));
+  std::memcpy(bytes + kVerticesOffset, vertices, sizeof(vertices));
   uint32_t indices[kMaxTriangles * 3];
   for (uint32_t i = 0; i < kMaxTriangles * 3; ++i) indices[i] = i;
-  std::memcpy(bytes + 256, indices, sizeof(indices));
+  std::memcpy(bytes + kIndicesOffset, indices, sizeof(indices));
   const float transform[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-  std::memcpy(bytes + 512, transform, sizeof(transform));
+  std::memcpy(bytes + kTransformOffset, transform, sizeof(transform));
   const float aabbs[kMaxTriangles][6] = {{0, 0, 0, 1, 1, 1}, {2, 0, 0, 3, 1, 1}};
-  std::memcpy(bytes + 768, aabbs, sizeof(aabbs));
+  std::memcpy(bytes + kAabbsOffset, aabbs, sizeof(aabbs));
 }
 
 Inputs::~Inputs() { device_.Destroy(buffer_); }
@@ -161,6 +162,8 @@ BuildInfo MakeBuildInfo(const Shape& shape, const Inputs& inputs) {
       if (shape.transform) t.transformData.deviceAddress = inputs.transform();
     }
     b.ranges[j].primitiveCount = shape.triangles;
+    b.ranges[j].primitiveOffset = shape.primitive_offset;
+    b.ranges[j].firstVertex = shape.first_vertex;
   }
   b.info.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
   b.info.type = shape.type;

@@ -50,7 +50,9 @@ class Commands {
   explicit Commands(vkkit::Device& device);
   ~Commands();
   VkCommandBuffer Begin();           // a new primary command buffer, begun
-  VkCommandBuffer BeginSecondary();  // a new secondary command buffer, begun (no render pass)
+  // A new secondary command buffer, begun (no render pass) with `flags` (e.g. SIMULTANEOUS_USE, to execute it
+  // twice in one primary).
+  VkCommandBuffer BeginSecondary(VkCommandBufferUsageFlags flags = 0);
   void End(VkCommandBuffer cb);
   // AS-build and AS-copy writes before the next AS-build/copy reads and writes (and query writes).
   void Barrier(VkCommandBuffer cb);
@@ -78,23 +80,33 @@ struct Shape {
   uint32_t max_vertex = 0;  // 0: the highest vertex the triangles use
   VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
   bool transform = false;
+  // Each geometry's build range (VkAccelerationStructureBuildRangeInfoKHR), besides primitiveCount.
+  uint32_t primitive_offset = 0;
+  uint32_t first_vertex = 0;
 };
 
 // Build inputs for any Shape (up to kMaxGeometries geometries of kMaxTriangles triangles): vertices, 32-bit
-// indices, a transform and AABBs, in one host-visible buffer.
+// indices, a transform and AABBs, in one host-visible buffer. `extra_usage` is added to the buffer's usage
+// (TRANSFER_DST for tests that write the inputs on the device).
 class Inputs {
  public:
   static constexpr uint32_t kMaxGeometries = 3;
   static constexpr uint32_t kMaxTriangles = 2;
   static constexpr uint32_t kVertexCount = 16;
-  explicit Inputs(vkkit::Device& device);
+  // Byte offsets of each input in buffer().
+  static constexpr VkDeviceSize kVerticesOffset = 0;
+  static constexpr VkDeviceSize kIndicesOffset = 256;
+  static constexpr VkDeviceSize kTransformOffset = 512;
+  static constexpr VkDeviceSize kAabbsOffset = 768;
+  explicit Inputs(vkkit::Device& device, VkBufferUsageFlags extra_usage = 0);
   ~Inputs();
   Inputs(const Inputs&) = delete;
   Inputs& operator=(const Inputs&) = delete;
-  VkDeviceAddress vertices() const { return buffer_.address; }
-  VkDeviceAddress indices() const { return buffer_.address + 256; }
-  VkDeviceAddress transform() const { return buffer_.address + 512; }
-  VkDeviceAddress aabbs() const { return buffer_.address + 768; }
+  VkDeviceAddress vertices() const { return buffer_.address + kVerticesOffset; }
+  VkDeviceAddress indices() const { return buffer_.address + kIndicesOffset; }
+  VkDeviceAddress transform() const { return buffer_.address + kTransformOffset; }
+  VkDeviceAddress aabbs() const { return buffer_.address + kAabbsOffset; }
+  const vkkit::Buffer& buffer() const { return buffer_; }
 
  private:
   vkkit::Device& device_;
