@@ -82,19 +82,32 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
   if (t_processing) return;
   std::lock_guard<std::recursive_mutex> order(processing_);
   t_processing = true;
-  // Submissions up to the last one carrying a waited app fence are covered: that fence signaled, so that
-  // submission completed, and the layer's fence of each earlier one is at most a moment away.
-  std::size_t covered_until = 0;  // pending_ entries [0, covered_until) with a covered app fence
+  // On a queue, submissions up to the last one carrying a waited app fence are covered: that fence signaled, so
+  // that submission completed, and the layer's fence of each earlier one on that queue is at most a moment away.
+  // Other queues' submissions are not waited for (they may run long); processing stops at the first of them
+  // still pending, and goes on at the next wait or submission.
+  std::vector<std::pair<VkQueue, std::size_t>> covered_until;  // per queue: entries [0, index) of it are covered
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (std::size_t k = 0; k < pending_.size(); ++k) {
+    for (std::size_t k = 0; k < pending_.size() && covered.fence_count != 0; ++k) {
       const Pending& p = pending_[k];
-      if (p.app_fence && std::find(covered.fences, covered.fences + covered.fence_count, p.app_fence) !=
-                             covered.fences + covered.fence_count) {
-        covered_until = k + 1;
+      if (!p.app_fence || std::find(covered.fences, covered.fences + covered.fence_count, p.app_fence) ==
+                              covered.fences + covered.fence_count) {
+        continue;
       }
+      bool known = false;
+      for (auto& [queue, until] : covered_until) {
+        if (queue == p.queue) until = k + 1, known = true;
+      }
+      if (!known) covered_until.emplace_back(p.queue, k + 1);
     }
   }
+  const auto fence_covers = [&](const Pending& p, std::size_t k) {
+    for (const auto& [queue, until] : covered_until) {
+      if (queue == p.queue && k < until) return true;
+    }
+    return false;
+  };
   for (std::size_t k = 0;; ++k) {
     Pending current;
     {
@@ -102,7 +115,7 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       if (pending_.empty()) break;
       Pending& p = pending_.front();
       VkResult status = next_.GetFenceStatus(device_, p.fence);
-      const bool covered_here = k < covered_until || covered.all || (covered.queue && p.queue == covered.queue);
+      const bool covered_here = covered.all || (covered.queue && p.queue == covered.queue) || fence_covers(p, k);
       if (status == VK_NOT_READY && covered_here) {
         status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
       }

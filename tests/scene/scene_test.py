@@ -63,7 +63,7 @@ def checked_vuids(checks_dir):
     for path in sorted(glob.glob(os.path.join(checks_dir, "*.json"))):
         with open(path) as f:
             for entry in json.load(f):
-                if entry.get("status") == "checked":
+                if entry.get("status") in ("checked", "partial"):  # partial: the scene's fault is in the checked part
                     checked.add(entry["vuid"])
     return checked
 
