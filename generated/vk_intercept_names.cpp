@@ -37,6 +37,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyDebugUtilsMessengerEXT",
     "vkDestroyDeferredOperationKHR",
     "vkDestroyDevice",
+    "vkDestroyFence",
     "vkDestroyInstance",
     "vkDestroyQueryPool",
     "vkDeviceWaitIdle",
@@ -55,6 +56,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkQueueWaitIdle",
     "vkResetCommandBuffer",
     "vkResetCommandPool",
+    "vkResetFences",
     "vkSetDebugUtilsObjectNameEXT",
     "vkUnmapMemory",
     "vkWaitForFences",
@@ -95,6 +97,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     false,  // vkDestroyDebugUtilsMessengerEXT
     true,  // vkDestroyDeferredOperationKHR
     true,  // vkDestroyDevice
+    true,  // vkDestroyFence
     false,  // vkDestroyInstance
     true,  // vkDestroyQueryPool
     true,  // vkDeviceWaitIdle
@@ -113,6 +116,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkQueueWaitIdle
     true,  // vkResetCommandBuffer
     true,  // vkResetCommandPool
+    true,  // vkResetFences
     true,  // vkSetDebugUtilsObjectNameEXT
     true,  // vkUnmapMemory
     true,  // vkWaitForFences

@@ -14,7 +14,7 @@ thread_local bool t_processing = false;
 }  // namespace
 
 CaptureTracker::~CaptureTracker() {
-  for (Pending& p : pending_) {
+  for (const Pending& p : pending_) {
     if (p.fence) next_.DestroyFence(device_, p.fence, nullptr);
   }
   for (VkFence f : free_fences_) next_.DestroyFence(device_, f, nullptr);
@@ -52,6 +52,16 @@ void CaptureTracker::Unreserve(const SubmissionCaptures& captures) {
 }
 
 void CaptureTracker::Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures) {
+  if (app_fence) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Pending p;
+    p.queue = queue;
+    p.app_fence = app_fence;
+    p.captures = std::move(captures);
+    pending_.push_back(std::move(p));
+    pending_count_.fetch_add(1, std::memory_order_release);
+    return;
+  }
   const VkFence fence = TakeFence();
   // Without a fence of its own the layer cannot know when the bytes are there: nothing is read (unknown).
   if (!fence || next_.QueueSubmit(queue, 0, nullptr, fence) != VK_SUCCESS) {
@@ -64,8 +74,22 @@ void CaptureTracker::Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  pending_.push_back(Pending{queue, app_fence, fence, std::move(captures)});
+  Pending p;
+  p.queue = queue;
+  p.fence = fence;
+  p.captures = std::move(captures);
+  pending_.push_back(std::move(p));
   pending_count_.fetch_add(1, std::memory_order_release);
+}
+
+void CaptureTracker::FenceRetired(VkFence app_fence) {
+  if (!app_fence || idle()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (Pending& p : pending_) {
+    if (p.app_fence != app_fence) continue;
+    p.complete = true;
+    p.app_fence = VK_NULL_HANDLE;
+  }
 }
 
 // With the processing lock held.
@@ -73,6 +97,7 @@ void CaptureTracker::Retire(Pending& p) {
   for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) {
     if (--log->pending_submissions == 0) log->overlapped = false;
   }
+  if (!p.fence) return;
   next_.ResetFences(device_, 1, &p.fence);
   free_fences_.push_back(p.fence);
   p.fence = VK_NULL_HANDLE;
@@ -114,12 +139,21 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       std::lock_guard<std::mutex> lock(mutex_);
       if (pending_.empty()) break;
       Pending& p = pending_.front();
-      VkResult status = next_.GetFenceStatus(device_, p.fence);
+      // The app's wait covers it: its queue or device went idle, or a fence signaled whose first scope holds it
+      // (a fence signal covers every earlier submission to its queue).
       const bool covered_here = covered.all || (covered.queue && p.queue == covered.queue) || fence_covers(p, k);
-      if (status == VK_NOT_READY && covered_here) {
-        status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
+      bool done = p.complete;
+      if (!done && p.fence) {
+        VkResult status = next_.GetFenceStatus(device_, p.fence);
+        if (status == VK_NOT_READY && covered_here) {
+          status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
+        }
+        done = status == VK_SUCCESS;
+      } else if (!done) {
+        // The app's fence is alive while it names the submission (FenceRetired): polling it is safe.
+        done = covered_here || (p.app_fence && next_.GetFenceStatus(device_, p.app_fence) == VK_SUCCESS);
       }
-      if (status != VK_SUCCESS) break;  // still pending (or the device was lost): later, in order
+      if (!done) break;  // still pending (or the device was lost): later, in order
       current = std::move(p);
       pending_.pop_front();
       pending_count_.fetch_sub(1, std::memory_order_release);

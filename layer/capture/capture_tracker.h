@@ -1,14 +1,17 @@
 #pragma once
-// Completion of submissions that carry captures (execution-time capture, issue 12). After such a submission
-// succeeds, the layer submits an empty batch with a fence of its own to the same queue: it signals once all work
-// submitted before it has completed. Completed submissions are processed in submission order (their captured
+// Completion of submissions that carry captures (execution-time capture, issue 12). A submission with the app's
+// own fence is complete once that fence is seen signaled (polled through the next element, or waited for by the
+// app), or reset or destroyed by the app (both require the submission to have completed), or its queue or
+// device waited idle. A submission without a fence gets one of the layer's: after it succeeds, the layer submits
+// an empty batch with its fence to the same queue, which signals once all work submitted before it completed. Completed submissions are processed in submission order (their captured
 // builds' activity filled, then the update rules run on it) when the app learns of completion: in the wait
 // hooks (after the app's wait returned, waiting for the layer's fence of each submission the app's wait covers:
 // the work is done, so that fence signals at once), at the next submission when already complete, and at
 // vkDestroyDevice. Findings are therefore reported before the app's wait returns.
 //
-// A fence on an empty submission rather than a timeline semaphore signal in the app's own submission: it needs
-// no device feature the app may not have enabled and leaves the app's submission as it was.
+// The app's fence, or a fence on an empty submission, rather than a timeline semaphore signal in the app's own
+// submission: no device feature the app may not have enabled, the app's submission left as it was, and no extra
+// submission at all when the app gives a fence (the common case: a frame's fence).
 #include <vulkan/vulkan.h>
 
 #include <atomic>
@@ -44,8 +47,11 @@ class CaptureTracker {
   void Reserve(const SubmissionCaptures& captures);
   // The submission was not made (skipped, or rejected by the driver).
   void Unreserve(const SubmissionCaptures& captures);
-  // It succeeded: the layer's fence follows it on `queue` (the app's fence, or null, names it for the waits).
+  // It succeeded, with the app's fence (or null: the layer's own fence then follows it on `queue`).
   void Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures);
+  // vkResetFences / vkDestroyFence of an app's fence: the submissions it was given to completed (the app may
+  // reset or destroy a fence only then), and the handle no longer names them.
+  void FenceRetired(VkFence app_fence);
   // Processes, in submission order, every submission that completed, and those `covered` names (waiting for
   // their layer fence); stops at the first one still pending. A call made while this thread is processing (from
   // an app callback) does nothing.
@@ -55,9 +61,10 @@ class CaptureTracker {
 
  private:
   struct Pending {
-    VkQueue queue;
-    VkFence app_fence;
-    VkFence fence;
+    VkQueue queue = VK_NULL_HANDLE;
+    VkFence app_fence = VK_NULL_HANDLE;  // the app's fence, while it names this submission
+    VkFence fence = VK_NULL_HANDLE;      // the layer's own, when the app gave none
+    bool complete = false;               // known complete (its app fence was reset or destroyed)
     SubmissionCaptures captures;
   };
   VkFence TakeFence();

@@ -35,9 +35,8 @@ std::string Named(const std::array<builder::ActivityChange, kNamed>& changes, st
 
 [[gnu::cold]] void Report(const CheckContext& ctx, const ActivityComparison& c, uint32_t geometry, const char* suffix,
                           const std::string& what) {
-  const Location loc = Location(OpCommandName(c.update.command))
-                           .Field(OpCommandArrayName(c.update.command), c.update.element)
-                           .Field("pGeometries", geometry);
+  // The command, as the other findings at execution; the message names the info (DescribeOrigin) and geometry.
+  const Location loc(OpCommandName(c.update.command));
   const std::string message = fmt::format(
       "{}: updates srcAccelerationStructure {} into {}; on execution, geometry {}: {}. The source's last executed "
       "build: {}.",

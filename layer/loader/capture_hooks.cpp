@@ -94,5 +94,20 @@ VKAPI_ATTR VkResult VKAPI_CALL GetSemaphoreCounterValue(VkDevice device, VkSemap
   return result;
 }
 
+// The app may reset or destroy a fence only once the submissions it was given to completed.
+VKAPI_ATTR VkResult VKAPI_CALL ResetFences(VkDevice device, uint32_t fenceCount, const VkFence* pFences) {
+  DeviceData* data = GetDeviceData(device);
+  if (data->capture_tracker && pFences) {
+    for (uint32_t k = 0; k < fenceCount; ++k) data->capture_tracker->FenceRetired(pFences[k]);
+  }
+  return data->dispatch.ResetFences(device, fenceCount, pFences);
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyFence(VkDevice device, VkFence fence, const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  if (data->capture_tracker) data->capture_tracker->FenceRetired(fence);  // before: the handle may be reused
+  data->dispatch.DestroyFence(device, fence, pAllocator);
+}
+
 }  // namespace hooks
 }  // namespace asval
