@@ -51,35 +51,29 @@ void CaptureTracker::Unreserve(const SubmissionCaptures& captures) {
   }
 }
 
-void CaptureTracker::Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures) {
-  if (app_fence) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    Pending p;
-    p.queue = queue;
-    p.app_fence = app_fence;
-    p.captures = std::move(captures);
-    pending_.push_back(std::move(p));
-    pending_count_.fetch_add(1, std::memory_order_release);
-    return;
-  }
-  const VkFence fence = TakeFence();
-  // Without a fence of its own the layer cannot know when the bytes are there: nothing is read (unknown).
-  if (!fence || next_.QueueSubmit(queue, 0, nullptr, fence) != VK_SUCCESS) {
+void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence, SubmissionCaptures&& captures) {
+  if (!app_fence && !layer_fence) {
+    // No fence to tell when the bytes are there: nothing is read (unknown).
     {
       std::lock_guard<std::recursive_mutex> order(processing_);
       for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
     }
     Unreserve(captures);
-    if (fence) next_.DestroyFence(device_, fence, nullptr);
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
   Pending p;
   p.queue = queue;
-  p.fence = fence;
+  p.app_fence = app_fence;
+  p.fence = layer_fence;
   p.captures = std::move(captures);
   pending_.push_back(std::move(p));
   pending_count_.fetch_add(1, std::memory_order_release);
+}
+
+void CaptureTracker::ReturnFence(VkFence fence) {
+  // After a failed submission its state is not known for sure: not reused.
+  if (fence) next_.DestroyFence(device_, fence, nullptr);
 }
 
 void CaptureTracker::FenceRetired(VkFence app_fence) {

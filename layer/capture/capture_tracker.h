@@ -2,16 +2,15 @@
 // Completion of submissions that carry captures (execution-time capture, issue 12). A submission with the app's
 // own fence is complete once that fence is seen signaled (polled through the next element, or waited for by the
 // app), or reset or destroyed by the app (both require the submission to have completed), or its queue or
-// device waited idle. A submission without a fence gets one of the layer's: after it succeeds, the layer submits
-// an empty batch with its fence to the same queue, which signals once all work submitted before it completed. Completed submissions are processed in submission order (their captured
+// device waited idle. A submission without a fence gets one of the layer's, passed down in place of the app's
+// VK_NULL_HANDLE (the app's submission is otherwise unchanged and cannot observe it). Completed submissions are processed in submission order (their captured
 // builds' activity filled, then the update rules run on it) when the app learns of completion: in the wait
 // hooks (after the app's wait returned, waiting for the layer's fence of each submission the app's wait covers:
 // the work is done, so that fence signals at once), at the next submission when already complete, and at
 // vkDestroyDevice. Findings are therefore reported before the app's wait returns.
 //
-// The app's fence, or a fence on an empty submission, rather than a timeline semaphore signal in the app's own
-// submission: no device feature the app may not have enabled, the app's submission left as it was, and no extra
-// submission at all when the app gives a fence (the common case: a frame's fence).
+// A fence rather than a timeline semaphore signal added to the app's submission: no device feature the app may
+// not have enabled, no batch added, and no extra submission.
 #include <vulkan/vulkan.h>
 
 #include <atomic>
@@ -47,8 +46,13 @@ class CaptureTracker {
   void Reserve(const SubmissionCaptures& captures);
   // The submission was not made (skipped, or rejected by the driver).
   void Unreserve(const SubmissionCaptures& captures);
-  // It succeeded, with the app's fence (or null: the layer's own fence then follows it on `queue`).
-  void Track(VkQueue queue, VkFence app_fence, SubmissionCaptures&& captures);
+  // The fence to pass down with a submission that carries captures when the app gives none (null when none
+  // could be made: its captures are then unknown).
+  VkFence TakeFence();
+  // The submission succeeded, with the app's fence or, when it gave none, layer_fence in its place. On failure
+  // the layer's fence is given back with ReturnFence.
+  void Track(VkQueue queue, VkFence app_fence, VkFence layer_fence, SubmissionCaptures&& captures);
+  void ReturnFence(VkFence fence);
   // vkResetFences / vkDestroyFence of an app's fence: the submissions it was given to completed (the app may
   // reset or destroy a fence only then), and the handle no longer names them.
   void FenceRetired(VkFence app_fence);
@@ -67,7 +71,6 @@ class CaptureTracker {
     bool complete = false;               // known complete (its app fence was reset or destroyed)
     SubmissionCaptures captures;
   };
-  VkFence TakeFence();
   void Retire(Pending& p);
 
   const VkDevice device_;

@@ -30,14 +30,22 @@ VkResult Submit(DeviceData& data, VkQueue queue, VkFence fence, ForEachCommandBu
     return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   // Pre-record: the recordings whose captures run now count as pending before the device may write them.
+  // Without a fence of the app's, the layer's own goes down in its place and tells when the bytes are there.
   const bool captures = data.capture_tracker && !submission.captures().empty();
-  if (captures) data.capture_tracker->Reserve(submission.captures());
-  const VkResult result = downcall();
+  VkFence layer_fence = VK_NULL_HANDLE;
+  if (captures) {
+    data.capture_tracker->Reserve(submission.captures());
+    if (!fence) layer_fence = data.capture_tracker->TakeFence();
+  }
+  const VkResult result = downcall(fence ? fence : layer_fence);
   if (result != VK_SUCCESS) {
-    if (captures) data.capture_tracker->Unreserve(submission.captures());
+    if (captures) {
+      data.capture_tracker->Unreserve(submission.captures());
+      data.capture_tracker->ReturnFence(layer_fence);
+    }
     submission.Undo();
   } else if (captures) {
-    data.capture_tracker->Track(queue, fence, std::move(submission.captures()));
+    data.capture_tracker->Track(queue, fence, layer_fence, std::move(submission.captures()));
   }
   return result;
 }
@@ -57,7 +65,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, 
           }
         }
       },
-      [&] { return data->dispatch.QueueSubmit(queue, submitCount, pSubmits, fence); });
+      [&](VkFence down_fence) { return data->dispatch.QueueSubmit(queue, submitCount, pSubmits, down_fence); });
 }
 
 // Also vkQueueSubmit2KHR (the generated intercept table maps the alias here).
@@ -75,7 +83,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t submitCount,
           }
         }
       },
-      [&] { return data->dispatch.QueueSubmit2(queue, submitCount, pSubmits, fence); });
+      [&](VkFence down_fence) { return data->dispatch.QueueSubmit2(queue, submitCount, pSubmits, down_fence); });
 }
 
 }  // namespace asval::hooks
