@@ -11,6 +11,7 @@ namespace {
 
 constexpr VkDeviceSize kNoBytes = std::numeric_limits<VkDeviceSize>::max();
 constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);  // 24
+constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
 constexpr VkDeviceSize kAlignment = 16;
 
 VkDeviceSize Add(VkDeviceSize a, VkDeviceSize b) { return a > kNoBytes - b ? kNoBytes : a + b; }
@@ -78,7 +79,16 @@ bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerat
         Source{Add(a.data.deviceAddress, r.primitiveOffset), Add(Mul(a.stride, n - 1), kAabbBytes), &out->data});
     return true;
   }
-  return false;  // instances: not captured yet
+  if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+    const VkAccelerationStructureGeometryInstancesDataKHR& in = g.geometry.instances;
+    // Arrays of pointers need the pointers read before the instances: not captured yet.
+    if (in.arrayOfPointers) return false;
+    if (n == 0) return true;
+    if (in.data.deviceAddress == 0) return false;
+    sources.push_back(Source{Add(in.data.deviceAddress, r.primitiveOffset), Mul(kInstanceBytes, n), &out->data});
+    return true;
+  }
+  return false;
 }
 
 // The buffer a range can be copied from: bound, created copyable by the layer, holding the whole range.
@@ -147,7 +157,9 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     if (!NeedsCapture(ctx.mode, info)) continue;
     if (captured.empty()) captured.assign(info_count, 0);
     const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges[i];
-    if (!info_ranges || (!info.pGeometries && !info.ppGeometries)) {
+    // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
+    const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
+    if (!info_ranges || (!info.pGeometries && !info.ppGeometries) || motion) {
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
       continue;
     }

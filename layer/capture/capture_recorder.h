@@ -5,9 +5,9 @@
 // log, and a barrier that makes the copies visible to the host and keeps later writes behind the reads.
 //
 // Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
-// update's source: their activity record) and updates; with `all`, every bottom-level build. Triangles and AABBs
-// only so far: an info with instances or a vertex format the builder does not decode is not captured (its
-// rules are skipped and counted when they would need it).
+// update's source: their activity record), updates, and every top-level build (its instance references); with
+// `all`, every bottom-level build too. Not captured yet (their rules skipped and counted): arrays of instance
+// pointers, motion instances, vertex formats the builder does not decode.
 #include <vulkan/vulkan.h>
 
 #include <atomic>
@@ -32,7 +32,10 @@ struct CaptureContext {
 
 // Whether a build info needs its inputs captured (cheap: the hot path of builds that need none).
 inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeometryInfoKHR& info) {
-  if (mode == kCaptureOff || info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
+  if (mode == kCaptureOff) return false;
+  // Top level: every build (its instance references are checked), and its updates (instance activity).
+  if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) return true;
+  if (info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
   return mode == kCaptureAll || info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
          (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "activity_rules.h"
+#include "instance_rules.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
@@ -16,6 +17,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
     for (const std::shared_ptr<BuildActivity>& activity : done.fills) activity->Fill();
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
+    for (const InstanceReferenceCheck& build : done.instance_checks) CheckInstanceReferences(ctx, build);
   });
 }
 

@@ -29,6 +29,12 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
     }
     view.range = g.range;
     result = builder::ClassifyTriangles(view, record, nullptr);
+  } else if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+    builder::InstanceGeometryView view;  // plain records (arrays of pointers are not captured)
+    view.data = log.Bytes(g.data);
+    view.dataBytes = g.data.size;
+    view.range = g.range;
+    result = builder::ClassifyInstances(view, record, nullptr);
   } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
     builder::AabbGeometryView view;
     view.data = log.Bytes(g.data);

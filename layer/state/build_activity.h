@@ -15,6 +15,7 @@
 #include "asval/builder/activity_record.h"
 #include "capture_log.h"
 #include "command_buffer_ops.h"
+#include "live_structure_addresses.h"
 
 namespace asval {
 
@@ -56,10 +57,20 @@ struct ActivityComparison {
   bool device_build = true;  // vkCmdBuildAccelerationStructuresKHR (else the indirect command): names the VUIDs
 };
 
+// A top-level build whose instances' references must name structures alive when it was submitted (06707).
+struct InstanceReferenceCheck {
+  std::shared_ptr<const CaptureLog> log;  // its captured instances
+  uint32_t info = 0;                      // in log->infos
+  std::shared_ptr<const LiveStructureAddresses> live;
+  OpOrigin build;
+  VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+};
+
 // What one submission's captures ask for once it completes, in submission order.
 struct SubmissionCaptures {
   std::vector<std::shared_ptr<BuildActivity>> fills;
   std::vector<ActivityComparison> comparisons;
+  std::vector<InstanceReferenceCheck> instance_checks;
   // The recordings whose captures this submission reads (each counted once in pending_submissions).
   std::vector<std::shared_ptr<CaptureLog>> logs;
   // Each capture read once per submission (history_apply.cpp).

@@ -14,6 +14,7 @@
 #include "history_state.h"
 #include "format_features.h"
 #include "host_mappings.h"
+#include "live_structure_addresses.h"
 #include "objects.h"
 
 namespace asval {
@@ -62,6 +63,8 @@ class DeviceState {
   // Buffer format features, asked of the driver once per format (vertexFormat-03797).
   FormatFeatureCache format_features;
 
+  // The device addresses of the live structures, as a top-level build submitted now must see them (capture).
+  LiveStructureAddressCache live_structure_addresses;
   // Execution-time capture (layer/capture): what it captured, and could not.
   mutable CaptureCounters capture_counters;
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the

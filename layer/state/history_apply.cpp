@@ -111,7 +111,8 @@ void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h
 // A captured build's activity, filled when its submission completes; an update's comparison with its source's.
 // The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
 // one call) holds the bytes of the last execution only: both are unknown.
-std::shared_ptr<BuildActivity> CapturedActivity(const HistoryStore& store, const AsOp& op, SubmissionCaptures& captures) {
+std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const HistoryStore& store, const AsOp& op,
+                                                SubmissionCaptures& captures) {
   CaptureLog* log = op.capture_log;
   auto node = std::make_shared<BuildActivity>(log->shared_from_this(), op.capture_info);
   const auto key = std::make_pair(static_cast<const CaptureLog*>(log), op.capture_info);
@@ -124,6 +125,15 @@ std::shared_ptr<BuildActivity> CapturedActivity(const HistoryStore& store, const
   for (const std::shared_ptr<CaptureLog>& held : captures.logs) known_log |= held.get() == log;
   if (!known_log) captures.logs.push_back(log->shared_from_this());
   captures.fills.push_back(node);
+  if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+    InstanceReferenceCheck check;
+    check.log = log->shared_from_this();
+    check.info = op.capture_info;
+    check.live = state.live_structure_addresses.Get(state.acceleration_structures);
+    check.build = op.origin;
+    check.dst = op.dst;
+    captures.instance_checks.push_back(std::move(check));
+  }
   if (op.is_update()) {
     const AsHistory* src = store.Find(op.src);
     ActivityComparison comparison;
@@ -158,7 +168,7 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
     const AsHistory* old = store.Find(op.dst);
     h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);
   }
-  if (captures && op.capture_log) h.activity = CapturedActivity(store, op, *captures);
+  if (captures && op.capture_log) h.activity = CapturedActivity(state, store, op, *captures);
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
 
