@@ -176,7 +176,10 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     }
     VkDeviceSize total = 0;
     for (const Source& s : sources) total = Add(total, s.size);
-    if (entry.complete && Add(log.bytes_captured, total) > ctx.budget_bytes) entry.complete = false;
+    if (entry.complete && Add(log.bytes_captured, total) > ctx.budget_bytes) {
+      entry.complete = false;
+      ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
+    }
     const std::size_t first_copy = copies.size();
     for (const Source& s : sources) {
       if (!entry.complete) break;

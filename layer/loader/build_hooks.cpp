@@ -2,6 +2,7 @@
 // families over it (validate), pass the call down unless the app's callback asked to skip it, then record
 // what it does to the structures' histories (post-record).
 #include "build_validation.h"
+#include "capture_notices.h"
 #include "check_thread_data.h"
 #include "history_recorder.h"
 #include "layer_data.h"
@@ -24,9 +25,10 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
   if (!any) return nullptr;
   const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
   if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown
-  return CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured)
-             ? captured.data()
-             : nullptr;
+  const bool any_captured =
+      CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured);
+  ReportCaptureBudget(MakeCheckContext(data), data.instance->settings.capture_budget_mb);
+  return any_captured ? captured.data() : nullptr;
 }
 
 }  // namespace

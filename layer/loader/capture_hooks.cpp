@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "activity_rules.h"
+#include "capture_notices.h"
 #include "instance_rules.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
@@ -15,7 +16,10 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   if (!data.capture_tracker || data.capture_tracker->idle()) return;
   const CheckContext ctx = MakeCheckContext(data);
   data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
-    for (const std::shared_ptr<BuildActivity>& activity : done.fills) activity->Fill();
+    for (const std::shared_ptr<BuildActivity>& activity : done.fills) {
+      activity->Fill();
+      ReportUndefinedInput(ctx, *activity);
+    }
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
     for (const InstanceReferenceCheck& build : done.instance_checks) CheckInstanceReferences(ctx, build);
   });

@@ -7,7 +7,8 @@ namespace asval {
 namespace {
 
 // The builder's view of one captured geometry; false when its bytes were not captured.
-bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record) {
+bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
+              builder::ClassifyResult* out) {
   if (g.range.primitiveCount == 0) {
     *record = builder::ActivityRecord{};
     return true;
@@ -45,6 +46,7 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   } else {
     return false;
   }
+  *out = result;
   // Primitives whose bytes the copy did not reach are recorded active: a guess. Unknown instead.
   return result.status == builder::ClassifyStatus::Ok && result.unreadable == 0 && !result.indexHashPartial;
 }
@@ -61,11 +63,14 @@ void BuildActivity::Fill() {
   const CapturedInfo& info = log->infos[info_];
   geometries_.resize(info.geometry_count);
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
-    if (!Classify(*log, log->geometries[info.first_geometry + j], &geometries_[j])) {
+    builder::ClassifyResult result;
+    if (!Classify(*log, log->geometries[info.first_geometry + j], &geometries_[j], &result)) {
       geometries_.clear();
+      undefined_.clear();
       MarkUnknown();
       return;
     }
+    if (result.undefinedNaN != 0) undefined_.push_back(UndefinedInput{j, result.undefinedNaN, result.firstUndefined});
   }
   status_ = Status::kReady;
   log_.reset();

@@ -23,7 +23,16 @@ class BuildActivity {
  public:
   enum class Status : uint8_t { kPending, kReady, kUnknown };
 
-  BuildActivity(std::shared_ptr<const CaptureLog> log, uint32_t info) : log_(std::move(log)), info_(info) {}
+  // Input the specification leaves undefined, found while classifying one geometry (a warning, not a rule).
+  struct UndefinedInput {
+    uint32_t geometry = 0;
+    uint32_t primitives = 0;       // triangles with a NaN Y or Z while X is not NaN (AABBs: NaN outside minX)
+    uint32_t first_primitive = 0;
+  };
+
+  BuildActivity(std::shared_ptr<const CaptureLog> log, uint32_t info, const OpOrigin& origin,
+                VkAccelerationStructureKHR dst)
+      : log_(std::move(log)), info_(info), origin_(origin), dst_(dst) {}
 
   Status status() const { return status_; }
   // kReady: one record per geometry of the build.
@@ -38,12 +47,20 @@ class BuildActivity {
     log_.reset();
   }
   const CaptureLog* log() const { return log_.get(); }
+  // The build (or update) this is the activity of.
+  const OpOrigin& origin() const { return origin_; }
+  VkAccelerationStructureKHR dst() const { return dst_; }
+  // kReady: the geometries with undefined input (usually none).
+  const std::vector<UndefinedInput>& undefined_input() const { return undefined_; }
 
  private:
   Status status_ = Status::kPending;
   std::shared_ptr<const CaptureLog> log_;  // until filled
   uint32_t info_ = 0;
   std::vector<builder::ActivityRecord> geometries_;
+  std::vector<UndefinedInput> undefined_;
+  OpOrigin origin_;
+  VkAccelerationStructureKHR dst_ = VK_NULL_HANDLE;
 };
 
 // An update to compare with the activity of its source's last executed build (pInfos-03663, 03664, 03768).

@@ -27,6 +27,10 @@ struct CaptureCounters {
   std::atomic<uint64_t> infos_not_captured{0};
   // Updates whose activity rules (03663/03664/03768) were judged on captured bytes.
   std::atomic<uint64_t> updates_compared{0};
+  // Infos not captured because the recording's captures would have exceeded capture_budget_mb (included in
+  // infos_not_captured), and whether that was reported (once per device).
+  std::atomic<uint64_t> infos_over_budget{0};
+  std::atomic<bool> budget_reported{false};
 };
 
 // One block of layer-owned memory that the device copies build inputs into and the host reads.

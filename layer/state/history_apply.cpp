@@ -114,7 +114,7 @@ void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h
 std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const HistoryStore& store, const AsOp& op,
                                                 SubmissionCaptures& captures) {
   CaptureLog* log = op.capture_log;
-  auto node = std::make_shared<BuildActivity>(log->shared_from_this(), op.capture_info);
+  auto node = std::make_shared<BuildActivity>(log->shared_from_this(), op.capture_info, op.origin, op.dst);
   const auto key = std::make_pair(static_cast<const CaptureLog*>(log), op.capture_info);
   auto [it, first] = captures.claimed.emplace(key, node.get());
   if (!first) {

@@ -1,0 +1,23 @@
+#pragma once
+// What the execution-time capture tells the app besides rule findings (layer-specific ids):
+//   ASVAL-Capture-UndefinedInput (warning): a captured build read a triangle with a NaN Y or Z component while X is
+//     not NaN (or an AABB with a NaN outside minX): the specification leaves what the build does undefined.
+//   ASVAL-Capture-Budget (warning, once per device): captures were skipped because a recording would have exceeded
+//     capture_budget_mb; their rules were skipped and counted.
+// Each can be muted by id with message_id_filter. Const: reports only.
+#include <cstdint>
+
+#include "build_activity.h"
+#include "check_context.h"
+
+namespace asval {
+
+inline constexpr const char kUndefinedInputId[] = "ASVAL-Capture-UndefinedInput";
+inline constexpr const char kCaptureBudgetId[] = "ASVAL-Capture-Budget";
+
+// After a captured build's activity was filled (the submission completed).
+void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity);
+// After a build's pre-record: reports the budget once, the first time it was exceeded on this device.
+void ReportCaptureBudget(const CheckContext& ctx, uint32_t budget_mb);
+
+}  // namespace asval
