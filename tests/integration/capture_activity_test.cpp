@@ -652,5 +652,29 @@ TEST_CASE("capture: with capture=all, an update that makes a triangle inactive i
   CHECK(OnlyFinding(f.monitor(), kBecameInactive, ": primitive 1") == "");
 }
 
+TEST_CASE("capture: a build that reads a NaN Y with X not NaN gets the undefined-input warning",
+          "[integration][capture]") {
+  // Y of triangle 1's second vertex is NaN, its X is not: the specification leaves the build's result undefined
+  // (a warning of the layer's own, ASVAL-Capture-UndefinedInput), and the triangle stays active.
+  HistoryFixture f;
+  Rig rig(f);
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    std::vector<uint32_t> vertices = Vertices();
+    vertices[3 * 4 + 1] = kNan;
+    rig.Write(cb, Component(0, 0), vertices);
+    rig.Build(cb, Triangles());
+  }));
+  CHECK(OnlyFinding(f.monitor(), "ASVAL-Capture-UndefinedInput", "geometry 0: 1 primitive(s)") == "");
+  // The twin: the same NaN Y on a triangle whose X is NaN too (inactive: nothing undefined) stays silent.
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    std::vector<uint32_t> vertices = Vertices();
+    vertices[3 * 4 + 0] = kNan;
+    vertices[3 * 4 + 1] = kNan;
+    rig.Write(cb, Component(0, 0), vertices);
+    rig.Build(cb, Triangles());
+  }));
+  CHECK(f.monitor().Verify() == "");
+}
+
 }  // namespace
 }  // namespace asval_test
