@@ -25,28 +25,38 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   });
 }
 
+namespace {
+
+// The app's wait returned `result`: on success, what it covers is processed before the app sees the result.
+VkResult AfterWait(DeviceData& data, VkResult result, const CaptureTracker::Covered& covered) {
+  if (result == VK_SUCCESS) ProcessCaptures(data, covered);
+  return result;
+}
+
+CaptureTracker::Covered Queue(VkQueue queue) {
+  CaptureTracker::Covered covered;
+  covered.queue = queue;
+  return covered;
+}
+
+CaptureTracker::Covered Everything() {
+  CaptureTracker::Covered covered;
+  covered.all = true;
+  return covered;
+}
+
+}  // namespace
+
 namespace hooks {
 
 VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
   DeviceData* data = GetDeviceData(queue);
-  const VkResult result = data->dispatch.QueueWaitIdle(queue);
-  if (result == VK_SUCCESS) {
-    CaptureTracker::Covered covered;
-    covered.queue = queue;
-    ProcessCaptures(*data, covered);
-  }
-  return result;
+  return AfterWait(*data, data->dispatch.QueueWaitIdle(queue), Queue(queue));
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL DeviceWaitIdle(VkDevice device) {
   DeviceData* data = GetDeviceData(device);
-  const VkResult result = data->dispatch.DeviceWaitIdle(device);
-  if (result == VK_SUCCESS) {
-    CaptureTracker::Covered covered;
-    covered.all = true;
-    ProcessCaptures(*data, covered);
-  }
-  return result;
+  return AfterWait(*data, data->dispatch.DeviceWaitIdle(device), Everything());
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL WaitForFences(VkDevice device, uint32_t fenceCount, const VkFence* pFences,
@@ -74,30 +84,23 @@ VKAPI_ATTR VkResult VKAPI_CALL WaitForFences(VkDevice device, uint32_t fenceCoun
 
 VKAPI_ATTR VkResult VKAPI_CALL GetFenceStatus(VkDevice device, VkFence fence) {
   DeviceData* data = GetDeviceData(device);
-  const VkResult result = data->dispatch.GetFenceStatus(device, fence);
-  if (result == VK_SUCCESS) {
-    CaptureTracker::Covered covered;
-    covered.fences = &fence;
-    covered.fence_count = 1;
-    ProcessCaptures(*data, covered);
-  }
-  return result;
+  CaptureTracker::Covered covered;
+  covered.fences = &fence;
+  covered.fence_count = 1;
+  return AfterWait(*data, data->dispatch.GetFenceStatus(device, fence), covered);
 }
 
 // Semaphore waits say nothing the layer maps to its submissions: what completed by now is processed.
 VKAPI_ATTR VkResult VKAPI_CALL WaitSemaphores(VkDevice device, const VkSemaphoreWaitInfo* pWaitInfo,
                                               uint64_t timeout) {
   DeviceData* data = GetDeviceData(device);
-  const VkResult result = data->dispatch.WaitSemaphores(device, pWaitInfo, timeout);
-  if (result == VK_SUCCESS) ProcessCaptures(*data, CaptureTracker::Covered{});
-  return result;
+  return AfterWait(*data, data->dispatch.WaitSemaphores(device, pWaitInfo, timeout), CaptureTracker::Covered{});
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL GetSemaphoreCounterValue(VkDevice device, VkSemaphore semaphore, uint64_t* pValue) {
   DeviceData* data = GetDeviceData(device);
-  const VkResult result = data->dispatch.GetSemaphoreCounterValue(device, semaphore, pValue);
-  if (result == VK_SUCCESS) ProcessCaptures(*data, CaptureTracker::Covered{});
-  return result;
+  return AfterWait(*data, data->dispatch.GetSemaphoreCounterValue(device, semaphore, pValue),
+                   CaptureTracker::Covered{});
 }
 
 // The app may reset or destroy a fence only once the submissions it was given to completed.
