@@ -243,6 +243,11 @@ void Blas::Recreate() {
   Create();
 }
 
+void Blas::DestroyHandle() {
+  if (handle_) device_.DestroyAccelerationStructureKHR(device_.handle(), handle_, nullptr);
+  handle_ = VK_NULL_HANDLE;
+}
+
 void Blas::Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
                   VkAccelerationStructureKHR src) {
   BuildInfo b = MakeBuildInfo(shape, *inputs_);

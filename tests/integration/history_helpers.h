@@ -143,6 +143,9 @@ class Blas {
   VkResult HostUpdate(const Shape& shape);
   // Destroys the structure (not its storage) and creates a new one in the same place.
   void Recreate();
+  // Destroys the structure, not its storage: address() stays backed by the same memory (a driver that reads the
+  // structures a top-level build's instances reference finds bytes there) but names no live structure.
+  void DestroyHandle();
 
  private:
   void Create();
