@@ -155,7 +155,7 @@ BuildInfo MakeBuildInfo(const Shape& shape, const Inputs& inputs) {
       t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
       t.vertexFormat = shape.vertex_format;
       t.vertexData.deviceAddress = inputs.vertices();
-      t.vertexStride = 12;
+      t.vertexStride = shape.vertex_stride;
       t.maxVertex = shape.max_vertex ? shape.max_vertex : 3 * shape.triangles - 1;
       t.indexType = shape.index_type;
       if (shape.index_type != VK_INDEX_TYPE_NONE_KHR) t.indexData.deviceAddress = inputs.indices();

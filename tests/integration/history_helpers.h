@@ -77,6 +77,7 @@ struct Shape {
   VkGeometryTypeKHR geometry_type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;  // or VK_GEOMETRY_TYPE_AABBS_KHR
   VkGeometryFlagsKHR geometry_flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
   VkFormat vertex_format = VK_FORMAT_R32G32B32_SFLOAT;
+  VkDeviceSize vertex_stride = 12;  // Inputs' own vertices are R32G32B32_SFLOAT, tightly packed
   uint32_t max_vertex = 0;  // 0: the highest vertex the triangles use
   VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
   bool transform = false;
