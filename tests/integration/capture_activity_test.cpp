@@ -13,6 +13,7 @@
 #include <functional>
 #include <thread>
 
+#include "capture_helpers.h"
 #include "history_helpers.h"
 
 namespace asval_test {
@@ -82,9 +83,6 @@ Shape Aabbs() {
   return s;
 }
 
-// How a test learns that its submission completed: each is a point where the layer reads the captures.
-enum class Wait { kQueueIdle, kFence, kFenceStatus, kDeviceIdle };
-
 // One structure over inputs the device writes, and the command buffers of a test.
 class Rig {
  public:
@@ -124,45 +122,13 @@ class Rig {
   }
 
   // The writes recorded so far made visible to the build stage's reads.
-  void InputsWritten(VkCommandBuffer cb) {
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
-                         1, &barrier, 0, nullptr, 0, nullptr);
-  }
+  void InputsWritten(VkCommandBuffer cb) { asval_test::InputsWritten(cb); }
 
   // A new command buffer holding what `record` records.
-  VkCommandBuffer Record(const std::function<void(VkCommandBuffer)>& record) {
-    VkCommandBuffer cb = commands_.Begin();
-    record(cb);
-    commands_.End(cb);
-    return cb;
-  }
+  VkCommandBuffer Record(const std::function<void(VkCommandBuffer)>& record) { return RecordWith(commands_, record); }
 
   // Submits cb and waits for it to complete in the way `wait` says.
-  void Run(VkCommandBuffer cb, Wait wait = Wait::kQueueIdle) {
-    VkFence fence = VK_NULL_HANDLE;
-    if (wait == Wait::kFence || wait == Wait::kFenceStatus) {
-      VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-      vkkit::Check(vkCreateFence(device_.handle(), &info, nullptr, &fence), "vkCreateFence");
-    }
-    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &cb;
-    vkkit::Check(vkQueueSubmit(device_.queue(), 1, &submit, fence), "vkQueueSubmit");
-    switch (wait) {
-      case Wait::kQueueIdle: vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle"); break;
-      case Wait::kFence:
-        vkkit::Check(vkWaitForFences(device_.handle(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-        break;
-      case Wait::kFenceStatus:
-        while (vkGetFenceStatus(device_.handle(), fence) == VK_NOT_READY) std::this_thread::yield();
-        break;
-      case Wait::kDeviceIdle: vkkit::Check(vkDeviceWaitIdle(device_.handle()), "vkDeviceWaitIdle"); break;
-    }
-    if (fence) vkDestroyFence(device_.handle(), fence, nullptr);
-  }
+  void Run(VkCommandBuffer cb, Wait wait = Wait::kQueueIdle) { SubmitAndWait(device_, cb, wait); }
 
  private:
   vkkit::Device& device_;
@@ -171,18 +137,6 @@ class Rig {
   Blas other_;
   Commands commands_;
 };
-
-// Empty when the only message since the last check is one `vuid` whose text holds `text`; else what was seen.
-std::string OnlyFinding(Monitor& monitor, const char* vuid, const std::string& text) {
-  const std::vector<Message> messages = monitor.Take();
-  if (messages.size() == 1 && messages[0].id_name == vuid && messages[0].text.find(text) != std::string::npos) {
-    return "";
-  }
-  std::string seen = "expected one " + std::string(vuid) + " naming '" + text + "', got " +
-                     std::to_string(messages.size()) + " message(s):\n";
-  for (const Message& m : messages) seen += m.id_name + ": " + m.text + "\n";
-  return seen;
-}
 
 // Whether the comparisons of the structure's updates are live: an update that now makes primitive 0 inactive
 // (a NaN X over vertex 0, or over box 0's minX) must be reported. A valid twin's silence only means something if

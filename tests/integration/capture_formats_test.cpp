@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "asval/vertex_formats.h"
+#include "capture_helpers.h"
 #include "history_helpers.h"
 #include "temp_report.h"
 
@@ -214,18 +215,6 @@ std::vector<uint32_t> Indices(VkIndexType type) {
   return {0, 1, 2, 3, 4, 5};
 }
 
-// Empty when the only message since the last check is one `vuid` whose text holds `text`; else what was seen.
-std::string OnlyFinding(Monitor& monitor, const char* vuid, const std::string& text) {
-  const std::vector<Message> messages = monitor.Take();
-  if (messages.size() == 1 && messages[0].id_name == vuid && messages[0].text.find(text) != std::string::npos) {
-    return "";
-  }
-  std::string seen = "expected one " + std::string(vuid) + " naming '" + text + "', got " +
-                     std::to_string(messages.size()) + " message(s):\n";
-  for (const Message& m : messages) seen += m.id_name + ": " + m.text + "\n";
-  return seen;
-}
-
 // One structure (two triangles, ALLOW_UPDATE) over inputs of its own in `e`'s format, written on the device.
 class FormatRig {
  public:
@@ -250,12 +239,7 @@ class FormatRig {
       const std::vector<uint32_t> indices = Indices(shape_.index_type);
       vkCmdUpdateBuffer(cb, buffer, Inputs::kIndicesOffset, indices.size() * sizeof(uint32_t), indices.data());
     }
-    // The writes made visible to the build stage's reads of the inputs.
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
-                         1, &barrier, 0, nullptr, 0, nullptr);
+    InputsWritten(cb);  // the writes made visible to the build stage's reads of the inputs
     if (build) {
       blas_.Build(cb, shape_);
     } else {

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "capture_helpers.h"
 #include "history_helpers.h"
 
 namespace asval_test {
@@ -53,7 +54,6 @@ std::string Names(uint32_t instance, VkDeviceAddress reference) {
   return "instance " + std::to_string(instance) + " references " + HexAddress(reference);
 }
 
-enum class Wait { kQueueIdle, kFence };
 
 // Bottom-level structures a top-level structure's instances reference, the instance buffer (written on the host
 // or on the device) and the command buffers of a test. a and b stay alive; `victim` is built, then its handle
@@ -117,40 +117,13 @@ class Rig {
     InputsWritten(cb);
     tlas_.Record(cb, instances_, count, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR);
   }
-  void InputsWritten(VkCommandBuffer cb) {
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
-                         1, &barrier, 0, nullptr, 0, nullptr);
-  }
+  void InputsWritten(VkCommandBuffer cb) { asval_test::InputsWritten(cb); }
 
-  VkCommandBuffer Record(const std::function<void(VkCommandBuffer)>& record) {
-    VkCommandBuffer cb = commands_.Begin();
-    record(cb);
-    commands_.End(cb);
-    return cb;
-  }
+  VkCommandBuffer Record(const std::function<void(VkCommandBuffer)>& record) { return RecordWith(commands_, record); }
 
   // Submits cb and waits for it to complete in the way `wait` says (each is a point where the layer reads the
   // captures and reports).
-  void Run(VkCommandBuffer cb, Wait wait = Wait::kQueueIdle) {
-    VkFence fence = VK_NULL_HANDLE;
-    if (wait == Wait::kFence) {
-      VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-      vkkit::Check(vkCreateFence(device_.handle(), &info, nullptr, &fence), "vkCreateFence");
-    }
-    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &cb;
-    vkkit::Check(vkQueueSubmit(device_.queue(), 1, &submit, fence), "vkQueueSubmit");
-    if (fence) {
-      vkkit::Check(vkWaitForFences(device_.handle(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-      vkDestroyFence(device_.handle(), fence, nullptr);
-    } else {
-      vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle");
-    }
-  }
+  void Run(VkCommandBuffer cb, Wait wait = Wait::kQueueIdle) { SubmitAndWait(device_, cb, wait); }
 
  private:
   vkkit::Device& device_;
@@ -162,18 +135,6 @@ class Rig {
   Commands commands_;
   vkkit::Buffer instances_;
 };
-
-// Empty when the only message since the last check is one `vuid` whose text holds `text`; else what was seen.
-std::string OnlyFinding(Monitor& monitor, const char* vuid, const std::string& text) {
-  const std::vector<Message> messages = monitor.Take();
-  if (messages.size() == 1 && messages[0].id_name == vuid && messages[0].text.find(text) != std::string::npos) {
-    return "";
-  }
-  std::string seen = "expected one " + std::string(vuid) + " naming '" + text + "', got " +
-                     std::to_string(messages.size()) + " message(s):\n";
-  for (const Message& m : messages) seen += m.id_name + ": " + m.text + "\n";
-  return seen;
-}
 
 // Whether the reference check is live: a build whose instance 0 references the victim's old address (its handle
 // destroyed now) must be reported. A valid twin's silence only means something if its references were judged

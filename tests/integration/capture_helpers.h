@@ -1,0 +1,31 @@
+#pragma once
+// What the execution-time capture tests share: the barrier that makes device writes of build inputs visible to
+// the build, a submission waited for in one of the ways the layer reads captures in, and the assertion that
+// exactly one finding was reported.
+#include <vulkan/vulkan.h>
+
+#include <functional>
+#include <string>
+
+#include "history_helpers.h"
+#include "monitor.h"
+#include "vkkit.h"
+
+namespace asval_test {
+
+// The transfer writes recorded so far (vkCmdUpdateBuffer, vkCmdFillBuffer) made visible to the build stage's reads.
+void InputsWritten(VkCommandBuffer cb);
+
+// A new primary command buffer of `commands` holding what `record` records, ended.
+VkCommandBuffer RecordWith(Commands& commands, const std::function<void(VkCommandBuffer)>& record);
+
+// How a test learns that its submission completed: each is a point where the layer reads the captures.
+enum class Wait { kQueueIdle, kFence, kFenceStatus, kDeviceIdle };
+
+// Submits cb alone and waits for it as `wait` says.
+void SubmitAndWait(vkkit::Device& device, VkCommandBuffer cb, Wait wait = Wait::kQueueIdle);
+
+// Empty when the only message since the last check is one `vuid` whose text holds `text`; else what was seen.
+std::string OnlyFinding(Monitor& monitor, const char* vuid, const std::string& text);
+
+}  // namespace asval_test
