@@ -12,6 +12,7 @@ namespace {
 constexpr VkDeviceSize kNoBytes = std::numeric_limits<VkDeviceSize>::max();
 constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);  // 24
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
+constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);                 // 48
 constexpr VkDeviceSize kAlignment = 16;
 
 VkDeviceSize Add(VkDeviceSize a, VkDeviceSize b) { return a > kNoBytes - b ? kNoBytes : a + b; }
@@ -31,6 +32,7 @@ struct Source {
   VkDeviceAddress address;
   VkDeviceSize size;
   CapturedBytes* into;
+  bool optional = false;  // not needed for the rules (a transform, for the warnings): skipped when not copyable
 };
 
 // The ranges geometry g reads (exactly the bytes the specification says a build consumes, from where it starts
@@ -52,6 +54,10 @@ bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerat
     out->index_type = t.indexType;
     if (n == 0) return true;
     if (t.vertexData.deviceAddress == 0) return false;
+    if (t.transformData.deviceAddress != 0) {
+      sources.push_back(Source{Add(t.transformData.deviceAddress, r.transformOffset), kTransformBytes, &out->transform,
+                               true});
+    }
     if (index_bytes == 0) {
       // Vertex k of the range is read at primitiveOffset + stride * (firstVertex + k); the last one for its size.
       const VkDeviceSize first = Add(r.primitiveOffset, Mul(t.vertexStride, r.firstVertex));
@@ -184,6 +190,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     for (const Source& s : sources) {
       if (!entry.complete) break;
       const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
+      if (!hit && s.optional) continue;
       if (!hit || !Allocate(ctx, log, s.size, s.into)) {
         entry.complete = false;
         break;

@@ -2,11 +2,25 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstring>
+
 namespace asval {
 
 void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity) {
   for (const BuildActivity::UndefinedInput& u : activity.undefined_input()) {
     const OpOrigin& origin = activity.origin();
+    if (u.transform_element >= 0) {
+      ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, Location(OpCommandName(origin.command)),
+                          {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, origin.command_buffer),
+                           Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, activity.dst())},
+                          fmt::format("{}: on execution, geometry {}: its transform (transformData) has a NaN or "
+                                      "infinite element, matrix[{}][{}]: every position it transforms is then NaN or "
+                                      "infinite.",
+                                      DescribeOrigin(origin), u.geometry, u.transform_element / 4,
+                                      u.transform_element % 4));
+    }
+    if (u.primitives == 0) continue;
     ctx.reporter.Report(
         Severity::kWarning, kUndefinedInputId, Location(OpCommandName(origin.command)),
         {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, origin.command_buffer),
@@ -15,6 +29,35 @@ void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity
                     "vertex, minX of an AABB) while that one is not NaN, for which the specification leaves the "
                     "build's result undefined (first: primitive {}).",
                     DescribeOrigin(origin), u.geometry, u.primitives, u.first_primitive));
+  }
+}
+
+void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build) {
+  const CaptureLog* log = build.log.get();
+  if (!log || build.info >= log->infos.size() || !log->infos[build.info].complete || log->overlapped) return;
+  const CapturedInfo& info = log->infos[build.info];
+  for (uint32_t j = 0; j < info.geometry_count; ++j) {
+    const CapturedGeometry& g = log->geometries[info.first_geometry + j];
+    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present) continue;
+    const uint8_t* bytes = log->Bytes(g.data);
+    uint32_t count = 0, first = 0;
+    int element = -1;
+    for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
+      for (int e = 0; e < 12; ++e) {
+        float value;
+        std::memcpy(&value, bytes + k * sizeof(VkAccelerationStructureInstanceKHR) + 4 * e, sizeof(value));
+        if (std::isfinite(value)) continue;
+        if (count++ == 0) first = k, element = e;
+        break;
+      }
+    }
+    if (count == 0) continue;
+    ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, Location(OpCommandName(build.build.command)),
+                        {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, build.build.command_buffer),
+                         Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, build.dst)},
+                        fmt::format("{}: on execution, geometry {}: {} instance(s) have a NaN or infinite element in "
+                                    "their transform (first: instance {}, matrix[{}][{}]).",
+                                    DescribeOrigin(build.build), j, count, first, element / 4, element % 4));
   }
 }
 

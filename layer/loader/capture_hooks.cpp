@@ -21,7 +21,10 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
       ReportUndefinedInput(ctx, *activity);
     }
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
-    for (const InstanceReferenceCheck& build : done.instance_checks) CheckInstanceReferences(ctx, build);
+    for (const InstanceReferenceCheck& build : done.instance_checks) {
+      CheckInstanceReferences(ctx, build);
+      ReportInstanceTransforms(ctx, build);
+    }
   });
 }
 

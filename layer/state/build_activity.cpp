@@ -1,5 +1,8 @@
 #include "build_activity.h"
 
+#include <cmath>
+#include <cstring>
+
 #include "asval/builder/classify.h"
 
 namespace asval {
@@ -51,6 +54,18 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   return result.status == builder::ClassifyStatus::Ok && result.unreadable == 0 && !result.indexHashPartial;
 }
 
+// The first NaN or infinite element of a captured transform (row * 4 + column), or -1.
+int NonFiniteElement(const CaptureLog& log, const CapturedGeometry& g) {
+  if (!g.transform.present) return -1;
+  const uint8_t* bytes = log.Bytes(g.transform);
+  for (int k = 0; k < 12; ++k) {
+    float value;
+    std::memcpy(&value, bytes + 4 * k, sizeof(value));
+    if (!std::isfinite(value)) return k;
+  }
+  return -1;
+}
+
 }  // namespace
 
 void BuildActivity::Fill() {
@@ -70,7 +85,10 @@ void BuildActivity::Fill() {
       MarkUnknown();
       return;
     }
-    if (result.undefinedNaN != 0) undefined_.push_back(UndefinedInput{j, result.undefinedNaN, result.firstUndefined});
+    const int transform_element = NonFiniteElement(*log, log->geometries[info.first_geometry + j]);
+    if (result.undefinedNaN != 0 || transform_element >= 0) {
+      undefined_.push_back(UndefinedInput{j, result.undefinedNaN, result.firstUndefined, transform_element});
+    }
   }
   status_ = Status::kReady;
   log_.reset();

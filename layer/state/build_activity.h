@@ -28,6 +28,7 @@ class BuildActivity {
     uint32_t geometry = 0;
     uint32_t primitives = 0;       // triangles with a NaN Y or Z while X is not NaN (AABBs: NaN outside minX)
     uint32_t first_primitive = 0;
+    int transform_element = -1;    // triangles: the first NaN or infinite element of the transform (row * 4 + col)
   };
 
   BuildActivity(std::shared_ptr<const CaptureLog> log, uint32_t info, const OpOrigin& origin,

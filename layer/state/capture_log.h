@@ -68,6 +68,7 @@ struct CapturedGeometry {
   builder::BuildRange range;  // primitiveCount, and the offsets still to apply to the captured bytes
   CapturedBytes data;         // vertices (triangles) or AABB records
   CapturedBytes indices;      // indexed triangles
+  CapturedBytes transform;    // triangles with a transform: its 48 bytes (for the warnings only; optional)
 };
 
 // One captured build info (pInfos[i] of a recorded build command).

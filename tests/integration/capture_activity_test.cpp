@@ -630,5 +630,25 @@ TEST_CASE("capture: a build that reads a NaN Y with X not NaN gets the undefined
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE("capture: a triangle geometry whose transform holds an infinity gets the non-finite-transform warning",
+          "[integration][capture]") {
+  // ASVAL-Capture-NonFiniteTransform: the transform's translation Y is written as +infinity on the device before
+  // the build. The twin: the helpers' identity transform stays silent.
+  HistoryFixture f;
+  Rig rig(f);
+  Shape shape = Triangles();
+  shape.transform = true;
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    rig.Write(cb, Component(0, 0), Vertices());
+    rig.Build(cb, shape);
+  }));
+  CHECK(f.monitor().Verify() == "");
+  rig.Run(rig.Record([&](VkCommandBuffer cb) {
+    rig.Write(cb, Inputs::kTransformOffset + 4 * 7, {0x7f800000u});  // matrix[1][3] = +inf
+    rig.Build(cb, shape);
+  }));
+  CHECK(OnlyFinding(f.monitor(), "ASVAL-Capture-NonFiniteTransform", "geometry 0: its transform") == "");
+}
+
 }  // namespace
 }  // namespace asval_test
