@@ -150,6 +150,52 @@ void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vect
 
 }  // namespace
 
+bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                           uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                           const VkDeviceAddress* addresses, const uint32_t* strides,
+                           const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured) {
+  captured.clear();
+  if (ctx.mode == kCaptureOff || !infos || !addresses || !strides || !max_primitive_counts || !ctx.next.CmdCopyBuffer ||
+      !ctx.next.CmdPipelineBarrier) {
+    return false;
+  }
+  std::vector<Copy> copies;
+  for (uint32_t i = 0; i < info_count; ++i) {
+    const uint32_t n = infos[i].geometryCount;
+    if (n == 0 || !max_primitive_counts[i] || addresses[i] == 0) continue;
+    if (captured.empty()) captured.assign(info_count, 0);
+    if (!recording.capture_log) recording.capture_log = std::make_shared<CaptureLog>(ctx.pool.shared_from_this());
+    CaptureLog& log = *recording.capture_log;
+    CapturedInfo entry;
+    entry.indirect = true;
+    entry.first_geometry = static_cast<uint32_t>(log.geometries.size());
+    entry.geometry_count = n;
+    entry.indirect_stride = strides[i];
+    log.geometries.resize(log.geometries.size() + n);
+    log.max_primitive_counts.resize(log.geometries.size(), 0);
+    for (uint32_t j = 0; j < n; ++j) log.max_primitive_counts[entry.first_geometry + j] = max_primitive_counts[i][j];
+    const VkDeviceSize bytes = Add(Mul(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
+    const std::optional<AddressHit> hit = Add(log.bytes_captured, bytes) <= ctx.budget_bytes
+                                              ? CopyableBuffer(ctx.state, addresses[i], bytes)
+                                              : std::nullopt;
+    if (hit && Allocate(ctx, log, bytes, &entry.ranges)) {
+      entry.ranges.present = true;
+      copies.push_back(Copy{hit->buffer, log.slabs[entry.ranges.slab].buffer,
+                            VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
+      log.bytes_captured = Add(log.bytes_captured, bytes);
+      ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
+      ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
+    } else {
+      entry.complete = false;
+      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+    }
+    log.infos.push_back(entry);
+    captured[i] = static_cast<uint32_t>(log.infos.size());
+  }
+  if (!copies.empty()) RecordCopies(ctx, cb, copies);
+  return !captured.empty();
+}
+
 bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,

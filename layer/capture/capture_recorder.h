@@ -47,4 +47,12 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, std::vector<uint32_t>& captured);
 
+// vkCmdBuildAccelerationStructuresIndirectKHR: records the copies of every info's range infos (read by the device
+// from pIndirectDeviceAddresses[i], pIndirectStrides[i] apart), keeping ppMaxPrimitiveCounts[i] with them, so that
+// the counts can be checked once the submission completes. `captured` as for CaptureBuildInputs.
+bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                           uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                           const VkDeviceAddress* addresses, const uint32_t* strides,
+                           const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured);
+
 }  // namespace asval

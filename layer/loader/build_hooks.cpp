@@ -67,11 +67,22 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   cmd.max_primitive_counts = ppMaxPrimitiveCounts;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
+  // Pre-record: the range infos the device will read, copied when the build executes (layer/capture).
+  const uint32_t* captured = nullptr;
+  if (data->capture_tracker) {
+    if (const std::shared_ptr<CommandBufferState> recording = data->state.command_buffers.Find(commandBuffer)) {
+      std::vector<uint32_t>& out = thread.data().captured_infos;
+      if (CaptureIndirectRanges(MakeCaptureContext(*data), commandBuffer, *recording, infoCount, pInfos,
+                                pIndirectDeviceAddresses, pIndirectStrides, ppMaxPrimitiveCounts, out)) {
+        captured = out.data();
+      }
+    }
+  }
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
                                                            pIndirectStrides, ppMaxPrimitiveCounts);
   // The ranges (and so the primitive counts) are on the device.
   RecordCmdBuild(data->state, commandBuffer, OpCommand::kCmdBuildIndirect, infoCount, pInfos, nullptr,
-                 &thread.data().last_recorded);
+                 &thread.data().last_recorded, captured);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(

@@ -6,6 +6,7 @@
 
 #include "activity_rules.h"
 #include "capture_notices.h"
+#include "indirect_rules.h"
 #include "instance_rules.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
@@ -25,6 +26,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
       CheckInstanceReferences(ctx, build);
       ReportInstanceTransforms(ctx, build);
     }
+    for (const IndirectRangeCheck& build : done.indirect_checks) CheckIndirectRanges(ctx, build);
   });
 }
 

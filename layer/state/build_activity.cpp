@@ -76,6 +76,10 @@ void BuildActivity::Fill() {
     return;
   }
   const CapturedInfo& info = log->infos[info_];
+  if (info.indirect) {  // only its range infos were captured: what it built from is not known
+    MarkUnknown();
+    return;
+  }
   geometries_.resize(info.geometry_count);
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     builder::ClassifyResult result;

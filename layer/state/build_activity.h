@@ -84,11 +84,20 @@ struct InstanceReferenceCheck {
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
 };
 
+// An indirect build whose range infos, read by the device, must respect ppMaxPrimitiveCounts (03653).
+struct IndirectRangeCheck {
+  std::shared_ptr<const CaptureLog> log;
+  uint32_t info = 0;
+  OpOrigin build;
+  VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+};
+
 // What one submission's captures ask for once it completes, in submission order.
 struct SubmissionCaptures {
   std::vector<std::shared_ptr<BuildActivity>> fills;
   std::vector<ActivityComparison> comparisons;
   std::vector<InstanceReferenceCheck> instance_checks;
+  std::vector<IndirectRangeCheck> indirect_checks;
   // The recordings whose captures this submission reads (each counted once in pending_submissions).
   std::vector<std::shared_ptr<CaptureLog>> logs;
   // Each capture read once per submission (history_apply.cpp).

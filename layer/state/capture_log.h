@@ -75,6 +75,11 @@ struct CapturedGeometry {
 struct CapturedInfo {
   uint32_t first_geometry = 0;  // into CaptureLog::geometries
   uint32_t geometry_count = 0;
+  // Indirect builds: the range infos read from pIndirectDeviceAddresses[i], geometry j's at j * indirect_stride,
+  // and ppMaxPrimitiveCounts[i][j] as recorded (in max_primitive_counts, from first_geometry on).
+  bool indirect = false;
+  CapturedBytes ranges;
+  uint32_t indirect_stride = 0;
   // Every geometry's bytes are captured (else the info's activity is unknown: counted, never guessed).
   bool complete = true;
 };
@@ -95,6 +100,7 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   VkDeviceSize bytes_captured = 0;
   std::vector<CapturedInfo> infos;
   std::vector<CapturedGeometry> geometries;
+  std::vector<uint32_t> max_primitive_counts;  // parallel to geometries (indirect infos only; else 0)
 
   // Submissions of this recording not yet processed (CaptureTracker, under its processing lock, which the readers
   // of the bytes hold too). A second one while the

@@ -125,7 +125,10 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
   for (const std::shared_ptr<CaptureLog>& held : captures.logs) known_log |= held.get() == log;
   if (!known_log) captures.logs.push_back(log->shared_from_this());
   captures.fills.push_back(node);
-  if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+  if (op.origin.command == OpCommand::kCmdBuildIndirect) {
+    captures.indirect_checks.push_back(IndirectRangeCheck{log->shared_from_this(), op.capture_info, op.origin, op.dst});
+  }
+  if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && op.origin.command != OpCommand::kCmdBuildIndirect) {
     InstanceReferenceCheck check;
     check.log = log->shared_from_this();
     check.info = op.capture_info;

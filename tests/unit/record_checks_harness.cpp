@@ -94,6 +94,14 @@ std::vector<std::string> RecordHarness::Collect(const BuildCommand& cmd, uint32_
   return ids_;
 }
 
+std::vector<std::string> RecordHarness::RunCheck(const std::function<void(const CheckContext&)>& check,
+                                                 uint32_t families) {
+  ids_.clear();
+  texts_.clear();
+  check(CheckContext{state_, reporter_, families});
+  return ids_;
+}
+
 std::vector<std::string> RecordHarness::Run(BuildCommandKind kind,
                                             const std::vector<VkAccelerationStructureBuildGeometryInfoKHR>& infos,
                                             const std::vector<const VkAccelerationStructureBuildRangeInfoKHR*>& ranges,

@@ -5,6 +5,7 @@
 // and host builds, which lavapipe cannot run.
 #include <vulkan/vulkan.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,10 @@ class RecordHarness {
                                        const std::vector<VkDeviceAddress>& addresses,
                                        const std::vector<uint32_t>& strides, uint32_t families = kRecordFamilies);
 
+  // Runs any const check over this harness's state and reporter (e.g. a rule judged on captured bytes); returns
+  // the VUIDs reported, in order.
+  std::vector<std::string> RunCheck(const std::function<void(const CheckContext&)>& check,
+                                    uint32_t families = kRecordFamilies);
   // The full text of the messages of the last Run.
   const std::vector<std::string>& texts() const { return texts_; }
 
