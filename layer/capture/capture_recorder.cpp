@@ -159,7 +159,8 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       !ctx.next.CmdPipelineBarrier) {
     return false;
   }
-  std::vector<Copy> copies;
+  thread_local std::vector<Copy> copies;  // kept from call to call on this thread: no allocation per call
+  copies.clear();
   for (uint32_t i = 0; i < info_count; ++i) {
     const uint32_t n = infos[i].geometryCount;
     if (n == 0 || !max_primitive_counts[i] || addresses[i] == 0) continue;
@@ -202,8 +203,10 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
                         std::vector<uint32_t>& captured) {
   captured.clear();
   if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
-  std::vector<Copy> copies;
-  std::vector<Source> sources;
+  // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
+  thread_local std::vector<Copy> copies;
+  thread_local std::vector<Source> sources;
+  copies.clear();
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
     if (!NeedsCapture(ctx.mode, info)) continue;
