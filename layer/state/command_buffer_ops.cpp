@@ -91,10 +91,6 @@ constexpr uint32_t kWrittenInPlaceFrom = 8;
 
 }  // namespace
 
-GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
-  Read(geometry, count, count_known);
-}
-
 void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
   type = geometry.geometryType;
   flags = geometry.flags;
@@ -107,12 +103,16 @@ void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, ui
     max_vertex = t.maxVertex;
     // The union's device and host members share storage: non-null either way reads as a non-zero address.
     has_transform = t.transformData.deviceAddress != 0;
+  } else {
+    vertex_format = VK_FORMAT_UNDEFINED;
+    index_type = VK_INDEX_TYPE_NONE_KHR;
+    max_vertex = 0;
+    has_transform = false;
   }
 }
 
 // Grows the array once and writes the records in place (the capacity was reserved): per geometry, push_back's
-// capacity test and its copy of the record cost more than the record itself; only the members a geometry sets
-// are written over the defaults.
+// capacity test and its copy of the record cost more than the record itself.
 void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& info,
                             const VkAccelerationStructureBuildRangeInfoKHR* info_ranges) {
   const std::size_t first = geometries_.size();
@@ -125,7 +125,7 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
   const std::size_t stride = info_ranges ? sizeof(VkAccelerationStructureBuildRangeInfoKHR) : 0;
   const bool known = info_ranges != nullptr;
   for (uint32_t j = 0; j < info.geometryCount; ++j, count += stride) {
-    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);  // resize wrote the defaults
+    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);
   }
 }
 

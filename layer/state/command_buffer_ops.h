@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "memory_range.h"
@@ -52,23 +53,26 @@ struct OpOrigin {
 // "pInfos[0] of the 3rd vkCmdBuildAccelerationStructuresKHR in VkCommandBuffer 0x..." (allocates: reports only).
 std::string DescribeOrigin(const OpOrigin& origin);
 
-// One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769).
+// One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769). No member initializers: the
+// batch's array grows by `resize` without writing anything (the default constructor is user-provided and empty),
+// and the constructor below and Read write every member.
 struct GeometryRecord {
-  GeometryRecord() = default;
-  // Reads one geometry of a build info; count_known is false for indirect builds. Every member is written
-  // once, in place (AppendBuilds emplaces it: no temporary record copied in).
-  GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
-  // The same over a record that holds the defaults (a default-constructed one): writes only what the geometry sets.
+  GeometryRecord() {}  // uninitialized: only for arrays whose records Read writes
+  // Reads one geometry of a build info; count_known is false for indirect builds.
+  GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+    Read(geometry, count, count_known);
+  }
+  // Writes every member from one geometry (the triangle members of other types get their defaults).
   void Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
 
-  VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-  VkGeometryFlagsKHR flags = 0;
-  VkFormat vertex_format = VK_FORMAT_UNDEFINED;  // triangles only
-  VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;  // triangles only
-  uint32_t max_vertex = 0;                       // triangles only
-  uint32_t primitive_count = 0;
-  bool has_transform = false;                    // triangles: transformData non-null
-  bool primitive_count_known = false;            // false for indirect builds (the count is on the device)
+  VkGeometryTypeKHR type;
+  VkGeometryFlagsKHR flags;
+  VkFormat vertex_format;       // triangles only (else VK_FORMAT_UNDEFINED)
+  VkIndexType index_type;       // triangles only (else VK_INDEX_TYPE_NONE_KHR)
+  uint32_t max_vertex;          // triangles only (else 0)
+  uint32_t primitive_count;
+  bool has_transform;           // triangles: transformData non-null (else false)
+  bool primitive_count_known;   // false for indirect builds (the count is on the device)
 
   friend bool operator==(const GeometryRecord& a, const GeometryRecord& b) {
     return a.type == b.type && a.flags == b.flags && a.vertex_format == b.vertex_format &&
@@ -77,6 +81,7 @@ struct GeometryRecord {
   }
   friend bool operator!=(const GeometryRecord& a, const GeometryRecord& b) { return !(a == b); }
 };
+static_assert(std::is_trivially_copyable_v<GeometryRecord>, "copied as bytes");
 
 enum class OpKind : uint8_t {
   kBuild,            // a build or update (mode says which) of dst
