@@ -18,6 +18,7 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
+  InputWindow window;
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
@@ -31,7 +32,7 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
       range = &cmd.ranges[i][j];
       if (range->primitiveCount == 0) continue;  // reads nothing
     }
-    skip |= InputReadRules(ctx, cmd, i, j, facts.Read(*g), range, memo, judge);
+    skip |= InputReadRules(ctx, cmd, i, j, facts.Read(*g), range, memo, window, judge);
   }
   return skip;
 }

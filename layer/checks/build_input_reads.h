@@ -98,13 +98,27 @@ template <typename Visit>
 [[gnu::cold, gnu::noinline]] bool ReportInputRead(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                                                   uint32_t j, const InputRead& read);
 
+// The buffer that held the last read of a walk over an info's geometries (with kInputUsage): the geometries of a
+// build mostly read one vertex buffer, so a read that lies inside it is held without asking the memo. Exact: the
+// window is a copy of a memo entry that served kInputUsage, and every entry stays a right answer for the call (the
+// memo was synced at its start); a read outside it asks the memo as before.
+struct InputWindow {
+  KnownBuffer held;  // size 0 (nothing yet) holds nothing
+};
+
 // The reads of geometry f (with its range, or null for an indirect build), each in one buffer of `memo`'s
 // device with kInputUsage.
 template <typename Judge>
 [[gnu::always_inline]] inline bool InputReadRules(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, const GeometryFacts& f,
-                    const VkAccelerationStructureBuildRangeInfoKHR* range, BufferMemo& memo, const Judge& judge) {
+                    const VkAccelerationStructureBuildRangeInfoKHR* range, BufferMemo& memo, InputWindow& window,
+                    const Judge& judge) {
   return ForEachRead(f, range, [&](const InputRead& read) {
-    if (memo.Held(ctx.state, read.address, read.size, kInputUsage)) return false;
+    if (window.held.Holds(read.address, read.size == 0 ? 1 : read.size)) return false;
+    if (const KnownBuffer* held = memo.Held(ctx.state, read.address, read.size, kInputUsage)) {
+      window.held.base = held->base;
+      window.held.size = held->size;
+      return false;
+    }
     return judge.Broken([&] { return ReportInputRead(ctx, cmd, i, j, read); });
   });
 }

@@ -34,6 +34,7 @@ uint8_t ScreenLoop(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
   const ScreeningJudge judge;
   StructureGeometryRules<ScreeningJudge> structure_rules(ctx, cmd, i);
   GeometryFactsReader reader(ctx.state);
+  InputWindow window;
   // Whether each family's rules found something (the screening rules return true then).
   bool structure_found = false, ranges_found = false, alignment_found = false, reads_found = false,
        counts_found = false;
@@ -49,7 +50,8 @@ uint8_t ScreenLoop(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
     if (addresses) {
       // A geometry with no primitives (or a maximum of 0) reads nothing.
       const bool reads = kDirect ? ranges[j].primitiveCount != 0 : max_counts[j] != 0;
-      if (reads) reads_found |= InputReadRules(ctx, cmd, i, j, facts, kDirect ? &ranges[j] : nullptr, *memo, judge);
+      if (reads) reads_found |= InputReadRules(ctx, cmd, i, j, facts, kDirect ? &ranges[j] : nullptr, *memo, window,
+                                                 judge);
       counts_found |= InstanceCountRule(ctx, cmd, i, j, facts, judge);
     }
   }
