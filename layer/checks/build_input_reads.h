@@ -51,7 +51,8 @@ template <typename Visit>
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
       const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
       InputRead vertices{InputKind::kVertices, false, t.vertexData.deviceAddress, 1};
-      if (r && t.indexType == VK_INDEX_TYPE_NONE_KHR) {
+      // f.index_size is 0 exactly for VK_INDEX_TYPE_NONE_KHR (IndexTypeSize), and already loaded.
+      if (r && f.index_size == 0) {
         // primitiveCount x 3 vertices from primitiveOffset + vertexStride x firstVertex; the last one is read
         // for its format's size, not its stride.
         const VkDeviceSize last = SaturatingAdd(r->firstVertex, SaturatingMul(3, count) - 1);
@@ -61,7 +62,7 @@ template <typename Visit>
       }
       result |= visit(vertices);
       // Indexed vertices are fetched where the indices say; only the start is known without reading them.
-      if (t.indexType != VK_INDEX_TYPE_NONE_KHR && f.index_size > 0) {
+      if (f.index_size > 0) {
         InputRead indices{InputKind::kIndices, r != nullptr, t.indexData.deviceAddress, 1};
         if (r) indices.size = SaturatingAdd(offset, SaturatingMul(SaturatingMul(3, count), f.index_size));
         result |= visit(indices);
