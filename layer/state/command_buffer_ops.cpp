@@ -143,18 +143,8 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
       const std::size_t needed = geometries_.size() + info.geometryCount;
       if (needed > geometries_.capacity()) geometries_.reserve(std::max(needed, 2 * geometries_.capacity()));
     }
-    AsOp& op = ops_.emplace_back();  // in place: an AsOp is large, and most of it stays at its defaults
-    op.kind = OpKind::kBuild;
-    op.origin = origin;
-    op.origin.element = i;
-    op.src = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
-                                                                           : VK_NULL_HANDLE;
-    op.dst = info.dstAccelerationStructure;
-    op.mode = info.mode;
-    op.flags = info.flags;
-    op.type = info.type;
-    op.geometry_count = info.geometryCount;
-    op.first_geometry = static_cast<uint32_t>(geometries_.size());
+    // In place, each member written once: an AsOp is large, and most of it stays at its defaults.
+    AsOp& op = ops_.emplace_back(origin, i, info, static_cast<uint32_t>(geometries_.size()));
     if (captured && captured[i] != 0) {
       op.capture_log = log;
       op.capture_info = captured[i] - 1;

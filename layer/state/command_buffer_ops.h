@@ -106,6 +106,21 @@ struct AsOp {
   // User-provided, so that value-initialization (emplace_back()) runs the member initializers only, without
   // zeroing the whole operation first.
   AsOp() {}
+  // A build or update of pInfos[element] of a build command recorded at `at`, whose geometries start at
+  // first_geometry in its batch: the build members written once, the others their defaults.
+  AsOp(const OpOrigin& at, uint32_t element, const VkAccelerationStructureBuildGeometryInfoKHR& info,
+       uint32_t first_geometry_index)
+      : origin(at),
+        src(info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
+                                                                         : VK_NULL_HANDLE),
+        dst(info.dstAccelerationStructure),
+        mode(info.mode),
+        flags(info.flags),
+        type(info.type),
+        geometry_count(info.geometryCount),
+        first_geometry(first_geometry_index) {
+    origin.element = element;
+  }
 
   OpKind kind = OpKind::kBuild;
   OpOrigin origin;
