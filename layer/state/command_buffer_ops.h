@@ -110,11 +110,11 @@ struct AsOp {
   // first_geometry in its batch: the build members written once, the others their defaults.
   AsOp(const OpOrigin& at, uint32_t element, const VkAccelerationStructureBuildGeometryInfoKHR& info,
        uint32_t first_geometry_index)
-      : origin(at),
+      : mode(info.mode),
+        origin(at),
         src(info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
                                                                          : VK_NULL_HANDLE),
         dst(info.dstAccelerationStructure),
-        mode(info.mode),
         flags(info.flags),
         type(info.type),
         geometry_count(info.geometryCount),
@@ -122,20 +122,22 @@ struct AsOp {
     origin.element = element;
   }
 
+  // The members are ordered by size within the groups below, so that the operation has no padding but the
+  // origin's (152 bytes: the batch's array grows and the command buffers copy them).
   OpKind kind = OpKind::kBuild;
+  // kBuild: the geometries could not be read (a null ppGeometries[j], or neither array given with
+  // geometryCount > 0): an invalid build, reported by the structure family; what it leaves in dst is unknown.
+  bool geometries_unreadable = false;
+  VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;  // kBuild
   OpOrigin origin;
   VkAccelerationStructureKHR src = VK_NULL_HANDLE;  // build (updates), copy, serialize
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;  // build, copy, deserialize, write properties
 
   // kBuild
-  VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
   VkBuildAccelerationStructureFlagsKHR flags = 0;
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   uint32_t geometry_count = 0;
   uint32_t first_geometry = 0;  // index into the batch's geometries
-  // The geometries could not be read (a null ppGeometries[j], or neither array given with geometryCount > 0):
-  // an invalid build, reported by the structure family; what it leaves in dst is unknown.
-  bool geometries_unreadable = false;
   // The bytes this build read, captured when it executes (issue 12): capture_info is its index in
   // capture_log->infos; capture_log is null when the build was not captured. The log is kept alive by the
   // published recording that holds this operation (RecordedOps::capture_logs).
@@ -148,11 +150,12 @@ struct AsOp {
 
   // kWriteProperties
   VkQueryType query_type = VK_QUERY_TYPE_OCCLUSION;
-  VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
   uint32_t query = 0;                       // firstQuery + element
+  VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
 
   bool is_update() const { return kind == OpKind::kBuild && mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR; }
 };
+static_assert(sizeof(AsOp) == 152, "no padding but the origin's: see the member order");
 
 // A sequence of operations in execution order, with their geometries.
 class OpBatch {
