@@ -14,7 +14,9 @@ namespace asval {
 
 namespace {
 
-bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, BufferMemo& memo) {
+// Out of line: walked only for infos the geometry pass flagged.
+[[gnu::noinline]] bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                              BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
