@@ -68,9 +68,11 @@ void ScreenGeometries(const CheckContext& ctx, const BuildCommand& cmd, uint32_t
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   r.walks = kWalkAll;
   if (cmd.is_host() || !GeometriesWalkable(ctx, info)) return;
-  const Families on{ctx.Enabled(kCheckStructure), ctx.Enabled(kCheckAlignment),
-                    memo != nullptr && ctx.Enabled(kCheckAddresses)};
-  const bool all_on = on.structure && on.alignment && on.addresses;
+  // The default settings (every family on) in one mask test; the flags one by one only for the others.
+  constexpr uint32_t kAll = kCheckStructure | kCheckAlignment | kCheckAddresses;
+  const bool all_on = memo != nullptr && (ctx.enabled_checks & kAll) == kAll;
+  const Families on{all_on || ctx.Enabled(kCheckStructure), all_on || ctx.Enabled(kCheckAlignment),
+                    all_on || (memo != nullptr && ctx.Enabled(kCheckAddresses))};
   // The counts the rules read: ppBuildRangeInfos[i] (direct builds), ppMaxPrimitiveCounts[i] (indirect builds).
   // Without them the families' own walks decide what is judged.
   if (cmd.is_indirect()) {
