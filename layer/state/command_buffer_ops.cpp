@@ -164,11 +164,8 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
             geometries_.resize(op.first_geometry);
             break;
           }
-          GeometryRecord& record = geometries_.emplace_back(GeometryRecord(*geometry, 0, false));
-          if (info_ranges) {
-            record.primitive_count = info_ranges[j].primitiveCount;
-            record.primitive_count_known = true;
-          }
+          geometries_.push_back(
+              GeometryRecord(*geometry, info_ranges ? info_ranges[j].primitiveCount : 0, info_ranges != nullptr));
         }
       }
     }
