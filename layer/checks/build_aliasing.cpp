@@ -345,12 +345,6 @@ Workspace& ClearedWorkspace(CheckThreadData& thread) {
 
 }  // namespace
 
-bool IsOneBuildAliasing(const BuildCommand& cmd) {
-  if (cmd.info_count != 1 || cmd.is_host()) return false;
-  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[0];
-  return info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE;
-}
-
 // CollectSpans for pInfos[0] without a source span (pInfos-03668 needs one too: nothing to check), then the
 // sweep only when the two spans may overlap: CertainlyDisjoint's pairwise test on two spans, the same one.
 bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,

@@ -71,7 +71,11 @@ class AliasingSweep {
 
 // Whether the command is one device build whose info is no update from another source: only its destination and
 // its scratch can overlap then (dstAccelerationStructure-03703), and ValidateOneBuildAliasing judges it.
-bool IsOneBuildAliasing(const BuildCommand& cmd);
+inline bool IsOneBuildAliasing(const BuildCommand& cmd) {
+  if (cmd.info_count != 1 || cmd.is_host()) return false;
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[0];
+  return info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE;
+}
 // The aliasing rules for such a command, instead of an AliasingSweep: the same findings and unknown-state counts,
 // without collecting the spans unless the two may overlap (then the sweep judges them, as it always did).
 bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
