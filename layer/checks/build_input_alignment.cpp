@@ -103,6 +103,7 @@ namespace {
 
 bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos || cmd.is_host()) return false;
+  if (!(resolved.walks() & kWalkInputAlignment) && !cmd.is_indirect()) return false;  // before any call: no frame
   bool skip = false;
   // Infos in which the command's geometry pass found nothing for these rules are not walked again.
   if (resolved.walks() & kWalkInputAlignment) skip |= WalkInputAlignment(ctx, cmd, resolved);

@@ -205,6 +205,7 @@ bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint3
 }
 
 bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
+  if (InfoSizesClean(r)) return false;
   // Infos in which the command's geometry pass found nothing for pInfos-03801 are not walked again.
   const bool counts = (r.walks & kWalkInstanceCounts) && ValidateInstanceCounts(ctx, cmd, i);
   return counts | ValidateDestinationSize(ctx, cmd, i, r);
