@@ -43,8 +43,10 @@ bool ValidateScratchAlignment(const CheckContext& ctx, const BuildCommand& cmd) 
 bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
   bool skip = false;
-  if (!cmd.is_host()) skip |= ValidateScratchAlignment(ctx, cmd);
-  skip |= ValidateInputAlignment(ctx, cmd, resolved);
+  if (cmd.is_host()) return skip;  // host builds read host addresses: no alignment rule (ValidateInputAlignment agrees)
+  skip |= ValidateScratchAlignment(ctx, cmd);
+  // The input rules have nothing to walk unless the geometry pass flagged an info, or the indirect arrays.
+  if ((resolved.walks() & kWalkInputAlignment) || cmd.is_indirect()) skip |= ValidateInputAlignment(ctx, cmd, resolved);
   return skip;
 }
 
