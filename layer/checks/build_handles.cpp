@@ -217,10 +217,42 @@ bool ValidateDistinctHandlesMany(const CheckContext& ctx, const BuildCommand& cm
 
 }  // namespace
 
+namespace {
+
+// Whether ValidateInfoHandles certainly has nothing to report or count for pInfos[i]: a live destination of the
+// build's type (or GENERIC), bound before it was created (or a host build), and no source, or a live one that needs
+// no binding test or was bound before it was created. Only compares, so that a loop over clean infos needs no call
+// and no stack frame; any other info takes the rules, which report exactly as before.
+inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                             const ResolvedInfo& r) {
+  const AccelerationStructureState* dst = r.dst;
+  if (!dst) return false;
+  if ((info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR ||
+       info.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) &&
+      dst->type != info.type && dst->type != VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) {
+    return false;
+  }
+  if (!cmd.is_host() && !dst->buffer_was_bound) return false;
+  if (info.srcAccelerationStructure == VK_NULL_HANDLE) return true;
+  if (!r.src) return false;
+  return cmd.is_host() || info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || r.src->buffer_was_bound;
+}
+
+// The rules for pInfos[i] (out of line: only for infos that are not certainly clean).
+[[gnu::noinline]] bool ValidateInfoHandlesFully(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                const ResolvedInfo& r) {
+  return ValidateInfoHandles(ctx, cmd, i, r);
+}
+
+}  // namespace
+
 bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i, resolved.info(i));
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+    const ResolvedInfo& r = resolved.info(i);
+    if (!InfoHandlesClean(cmd, cmd.infos[i], r)) skip |= ValidateInfoHandlesFully(ctx, cmd, i, r);
+  }
   if (cmd.info_count > kFewInfos) {
     skip |= ValidateDistinctHandlesMany(ctx, cmd);
   } else if (cmd.info_count > 1) {
