@@ -238,20 +238,14 @@ inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStruct
   return cmd.is_host() || info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || r.src->buffer_was_bound;
 }
 
-// The rules for pInfos[i] (out of line: only for infos that are not certainly clean).
-[[gnu::noinline]] bool ValidateInfoHandlesFully(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
-                                                const ResolvedInfo& r) {
-  return ValidateInfoHandles(ctx, cmd, i, r);
-}
-
-}  // namespace
-
-bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
-  if (!cmd.infos) return false;
+// The per-info rules from pInfos[first] on, the first info that is not certainly clean, then the rules between
+// infos (out of line).
+[[gnu::noinline]] bool ValidateInfosFrom(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved,
+                                         uint32_t first) {
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) {
+  for (uint32_t i = first; i < cmd.info_count; ++i) {
     const ResolvedInfo& r = resolved.info(i);
-    if (!InfoHandlesClean(cmd, cmd.infos[i], r)) skip |= ValidateInfoHandlesFully(ctx, cmd, i, r);
+    if (!InfoHandlesClean(cmd, cmd.infos[i], r)) skip |= ValidateInfoHandles(ctx, cmd, i, r);
   }
   if (cmd.info_count > kFewInfos) {
     skip |= ValidateDistinctHandlesMany(ctx, cmd);
@@ -259,6 +253,17 @@ bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, cons
     skip |= ValidateDistinctHandlesFew(ctx, cmd);
   }
   return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
+  if (!cmd.infos) return false;
+  // The clean infos first, by compares only: a one-info command of a clean info needs no call and no stack frame.
+  uint32_t i = 0;
+  while (i < cmd.info_count && InfoHandlesClean(cmd, cmd.infos[i], resolved.info(i))) ++i;
+  if (i == cmd.info_count && cmd.info_count <= 1) return false;
+  return ValidateInfosFrom(ctx, cmd, resolved, i);
 }
 
 }  // namespace asval
