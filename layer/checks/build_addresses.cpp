@@ -125,10 +125,7 @@ bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, ui
 bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                            BufferMemo& memo) {
   // The clean path of a device build (every rule below returns at once) before any call: no stack frame.
-  if (InfoSizesClean(r) && !cmd.is_host() && (r.scratch_bytes == 0 || r.scratch_in_storage) &&
-      !(r.walks & kWalkInputReads) && !cmd.is_indirect()) {
-    return false;
-  }
+  if (InfoAddressesClean(cmd, r)) return false;
   bool skip = ValidateInfoSizes(ctx, cmd, i, r);
   if (cmd.is_host()) return skip;  // host addresses: build_host.h
   skip |= ValidateScratch(ctx, cmd, i, r);

@@ -375,23 +375,7 @@ namespace {
 
 bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
                               CheckThreadData& thread) {
-  // The clean path, before any call (no stack frame): the destination's span is known, and the scratch is empty or
-  // lies in the bound buffer the resolution found, in other memory or other bytes. The same spans and the same
-  // overlap test as below, which then could neither count nor report anything.
-  if (r.sizes && r.dst && r.dst_buffer_known && r.dst_buffer.bound && r.dst_buffer.memory != VK_NULL_HANDLE) {
-    if (r.scratch_bytes == 0) return false;  // no scratch span
-    if (r.scratch_in_storage && r.scratch_buffer.bound) {
-      const KnownBuffer& b = r.dst_buffer;
-      const VkDeviceSize dst_begin = SaturatingAdd(b.memory_offset, r.dst->offset);
-      const VkDeviceSize dst_end =
-          SaturatingAdd(dst_begin, std::min(r.sizes->acceleration_structure_size, r.dst->size));
-      const KnownBuffer& s = r.scratch_buffer;
-      const VkDeviceSize scratch_begin =
-          SaturatingAdd(s.memory_offset, cmd.infos[0].scratchData.deviceAddress - s.base);
-      const VkDeviceSize scratch_end = SaturatingAdd(scratch_begin, r.scratch_bytes);
-      if (s.memory != b.memory || !(dst_begin < scratch_end && scratch_begin < dst_end)) return false;
-    }
-  }
+  if (OneBuildAliasingClean(cmd, r)) return false;  // before any call: no stack frame
   return ValidateOneBuildAliasingFully(ctx, cmd, r, memo, thread);
 }
 
