@@ -14,10 +14,13 @@ namespace asval {
 
 namespace {
 
-bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, BufferMemo& memo) {
+// Out of line: walked only for infos the geometry pass flagged.
+[[gnu::noinline]] bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                              BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
+  InputWindow window;
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
@@ -31,7 +34,7 @@ bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, ui
       range = &cmd.ranges[i][j];
       if (range->primitiveCount == 0) continue;  // reads nothing
     }
-    skip |= InputReadRules(ctx, cmd, i, j, facts.Read(*g), range, memo, judge);
+    skip |= InputReadRules(ctx, cmd, i, j, facts.Read(*g), range, memo, window, judge);
   }
   return skip;
 }
@@ -121,6 +124,8 @@ bool ValidateIndirectRanges(const CheckContext& ctx, const BuildCommand& cmd, ui
 
 bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                            BufferMemo& memo) {
+  // The clean path of a device build (every rule below returns at once) before any call: no stack frame.
+  if (InfoAddressesClean(cmd, r)) return false;
   bool skip = ValidateInfoSizes(ctx, cmd, i, r);
   if (cmd.is_host()) return skip;  // host addresses: build_host.h
   skip |= ValidateScratch(ctx, cmd, i, r);

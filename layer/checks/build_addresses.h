@@ -13,6 +13,7 @@
 //   pIndirectDeviceAddresses-03646 / 03647          the build ranges lie in one buffer with INDIRECT_BUFFER usage
 // Host builds use host addresses: their rules are in build_host.h. Sizes and limits: build_sizes.h.
 #include "buffer_memo.h"
+#include "build_sizes.h"
 #include "build_command.h"
 #include "resolved_build.h"
 #include "check_context.h"
@@ -22,5 +23,14 @@ namespace asval {
 // The rules above, plus those of build_sizes.h, for pInfos[i] (called by ValidateBuildMemory).
 bool ValidateInfoAddresses(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r,
                            BufferMemo& memo);
+
+// Whether ValidateInfoAddresses certainly has nothing to report or count for pInfos[i] of a device build: the sizes
+// are clean (InfoSizesClean), the scratch is empty or lies in a STORAGE_BUFFER buffer, the geometry pass found no
+// input read to judge, and the build is direct (no indirect ranges). Compares only: the caller tests it before any
+// call.
+inline bool InfoAddressesClean(const BuildCommand& cmd, const ResolvedInfo& r) {
+  return InfoSizesClean(r) && !cmd.is_host() && (r.scratch_bytes == 0 || r.scratch_in_storage) &&
+         !(r.walks & kWalkInputReads) && !cmd.is_indirect();
+}
 
 }  // namespace asval

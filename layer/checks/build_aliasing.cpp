@@ -345,16 +345,12 @@ Workspace& ClearedWorkspace(CheckThreadData& thread) {
 
 }  // namespace
 
-bool IsOneBuildAliasing(const BuildCommand& cmd) {
-  if (cmd.info_count != 1 || cmd.is_host()) return false;
-  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[0];
-  return info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE;
-}
-
 // CollectSpans for pInfos[0] without a source span (pInfos-03668 needs one too: nothing to check), then the
 // sweep only when the two spans may overlap: CertainlyDisjoint's pairwise test on two spans, the same one.
-bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
-                              CheckThreadData& thread) {
+namespace {
+
+[[gnu::noinline]] bool ValidateOneBuildAliasingFully(const CheckContext& ctx, const BuildCommand& cmd,
+                                                     const ResolvedInfo& r, BufferMemo& memo, CheckThreadData& thread) {
   if (!r.sizes) return false;  // counted by ValidateBuildMemory
   AccessSpan dst, scratch;
   const bool has_dst =
@@ -373,6 +369,14 @@ bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, 
   w.spans.push_back(dst);
   w.spans.push_back(scratch);
   return SweepOverlaps(ctx, cmd, w);
+}
+
+}  // namespace
+
+bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,
+                              CheckThreadData& thread) {
+  if (OneBuildAliasingClean(cmd, r)) return false;  // before any call: no stack frame
+  return ValidateOneBuildAliasingFully(ctx, cmd, r, memo, thread);
 }
 
 AliasingSweep::AliasingSweep(CheckThreadData& thread) : w_(&ClearedWorkspace(thread)) {}

@@ -14,11 +14,13 @@
 // all as the driver reports them for this build. They are compared as VkDeviceMemory offsets, so two buffers
 // over one allocation alias. The spans are sorted and swept once: O(n log n) for n infos, no all-pairs loop.
 // In-place updates (src == dst) are valid: an info's destination and its own source may be the same bytes.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
 
+#include "buffer_lookup.h"
 #include "buffer_memo.h"
 #include "build_command.h"
 #include "resolved_build.h"
@@ -71,7 +73,29 @@ class AliasingSweep {
 
 // Whether the command is one device build whose info is no update from another source: only its destination and
 // its scratch can overlap then (dstAccelerationStructure-03703), and ValidateOneBuildAliasing judges it.
-bool IsOneBuildAliasing(const BuildCommand& cmd);
+inline bool IsOneBuildAliasing(const BuildCommand& cmd) {
+  if (cmd.info_count != 1 || cmd.is_host()) return false;
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[0];
+  return info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || info.srcAccelerationStructure == VK_NULL_HANDLE;
+}
+// Whether ValidateOneBuildAliasing certainly has nothing to report or count: the destination's span is known, and
+// the scratch is empty or lies in the bound buffer the resolution found, in other memory or other bytes (the same
+// spans and overlap test as the rule's). Compares only: tested before any call.
+inline bool OneBuildAliasingClean(const BuildCommand& cmd, const ResolvedInfo& r) {
+  if (!r.sizes || !r.dst || !r.dst_buffer_known || !r.dst_buffer.bound || r.dst_buffer.memory == VK_NULL_HANDLE) {
+    return false;
+  }
+  if (r.scratch_bytes == 0) return true;  // no scratch span
+  if (!r.scratch_in_storage || !r.scratch_buffer.bound) return false;
+  const KnownBuffer& b = r.dst_buffer;
+  const VkDeviceSize dst_begin = SaturatingAdd(b.memory_offset, r.dst->offset);
+  const VkDeviceSize dst_end = SaturatingAdd(dst_begin, std::min(r.sizes->acceleration_structure_size, r.dst->size));
+  const KnownBuffer& s = r.scratch_buffer;
+  const VkDeviceSize scratch_begin = SaturatingAdd(s.memory_offset, cmd.infos[0].scratchData.deviceAddress - s.base);
+  const VkDeviceSize scratch_end = SaturatingAdd(scratch_begin, r.scratch_bytes);
+  return s.memory != b.memory || !(dst_begin < scratch_end && scratch_begin < dst_end);
+}
+
 // The aliasing rules for such a command, instead of an AliasingSweep: the same findings and unknown-state counts,
 // without collecting the spans unless the two may overlap (then the sweep judges them, as it always did).
 bool ValidateOneBuildAliasing(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedInfo& r, BufferMemo& memo,

@@ -42,9 +42,19 @@ bool ValidateScratchAlignment(const CheckContext& ctx, const BuildCommand& cmd) 
 
 bool ValidateBuildAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   if (!cmd.infos) return false;
+  // The clean path of a direct device build, before any call (no stack frame): the limit known, every scratch
+  // aligned, no input rule to walk.
+  const uint32_t alignment = ctx.state.properties.acceleration_structure.minAccelerationStructureScratchOffsetAlignment;
+  if (cmd.kind == BuildCommandKind::kCmdBuild && alignment != 0 && !(resolved.walks() & kWalkInputAlignment)) {
+    uint32_t i = 0;
+    while (i < cmd.info_count && cmd.infos[i].scratchData.deviceAddress % alignment == 0) ++i;
+    if (i == cmd.info_count) return false;
+  }
   bool skip = false;
-  if (!cmd.is_host()) skip |= ValidateScratchAlignment(ctx, cmd);
-  skip |= ValidateInputAlignment(ctx, cmd, resolved);
+  if (cmd.is_host()) return skip;  // host builds read host addresses: no alignment rule (ValidateInputAlignment agrees)
+  skip |= ValidateScratchAlignment(ctx, cmd);
+  // The input rules have nothing to walk unless the geometry pass flagged an info, or the indirect arrays.
+  if ((resolved.walks() & kWalkInputAlignment) || cmd.is_indirect()) skip |= ValidateInputAlignment(ctx, cmd, resolved);
   return skip;
 }
 

@@ -16,6 +16,38 @@ namespace {
 // Up to this many infos the duplicate rules compare all pairs (n^2 / 2 compares, no buffer); beyond, they sort.
 constexpr uint32_t kFewInfos = 16;
 
+// The reporting halves of the per-info rules below (cold, out of line, scalars only: the clean path keeps no
+// message pieces in its frame).
+[[gnu::cold, gnu::noinline]] bool ReportDestinationType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                        const AccelerationStructureState& dst, const char* vuid) {
+  const VkAccelerationStructureTypeKHR type = cmd.infos[i].type;
+  return ReportBuild(ctx, cmd, i, vuid,
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
+                     "(0x{:x}) was created with VkAccelerationStructureCreateInfoKHR::type {}, but pInfos[{}].type is "
+                     "{}: it must have been created with that type or VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR.",
+                     reinterpret_cast<uint64_t>(dst.handle), string_VkAccelerationStructureTypeKHR(dst.type), i,
+                     string_VkAccelerationStructureTypeKHR(type));
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportInvalidDestination(const CheckContext& ctx, const BuildCommand& cmd,
+                                                           uint32_t i) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  return ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
+                     "(0x{:x}) is not a valid VkAccelerationStructureKHR: {}.",
+                     reinterpret_cast<uint64_t>(info.dstAccelerationStructure),
+                     info.dstAccelerationStructure ? "no live acceleration structure of this device has this handle"
+                                                   : "it is VK_NULL_HANDLE");
+}
+
+[[gnu::cold, gnu::noinline]] bool ReportInvalidSource(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  return ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
+                     [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
+                     "(0x{:x}) is not VK_NULL_HANDLE and not a valid VkAccelerationStructureKHR: no live "
+                     "acceleration structure of this device has this handle.",
+                     reinterpret_cast<uint64_t>(cmd.infos[i].srcAccelerationStructure));
+}
+
 // pInfos-03699 / 03700: the build's type against the type the destination was created with.
 bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                              const AccelerationStructureState& dst) {
@@ -29,12 +61,7 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
     return false;  // GENERIC is a structure rule of its own (type-03654)
   }
   if (dst.type == type || dst.type == VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) return false;
-  return ReportBuild(ctx, cmd, i, vuid,
-                     [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
-                     "(0x{:x}) was created with VkAccelerationStructureCreateInfoKHR::type {}, but pInfos[{}].type is "
-                     "{}: it must have been created with that type or VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR.",
-                     reinterpret_cast<uint64_t>(dst.handle), string_VkAccelerationStructureTypeKHR(dst.type), i,
-                     string_VkAccelerationStructureTypeKHR(type));
+  return ReportDestinationType(ctx, cmd, i, dst, vuid);
 }
 
 // pInfos-03707 / 03708: the structure's buffer is bound. Unknown buffers and sparse buffers (bound through
@@ -65,12 +92,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
   bool skip = false;
   const AccelerationStructureState* dst = r.dst;
   if (!dst) {
-    skip |= ReportBuild(ctx, cmd, i, "dstAccelerationStructure-03800",
-                        [&](std::string&) { return InfoLocation(cmd, i).Field("dstAccelerationStructure"); },
-                        "(0x{:x}) is not a valid VkAccelerationStructureKHR: {}.",
-                        reinterpret_cast<uint64_t>(info.dstAccelerationStructure),
-                        info.dstAccelerationStructure ? "no live acceleration structure of this device has this handle"
-                                                      : "it is VK_NULL_HANDLE");
+    skip |= ReportInvalidDestination(ctx, cmd, i);
   } else {
     skip |= ValidateDestinationType(ctx, cmd, i, *dst);
     if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
@@ -78,11 +100,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
     const AccelerationStructureState* src = r.src;
     if (!src) {
-      skip |= ReportBuild(ctx, cmd, i, "srcAccelerationStructure-04629",
-                          [&](std::string&) { return InfoLocation(cmd, i).Field("srcAccelerationStructure"); },
-                          "(0x{:x}) is not VK_NULL_HANDLE and not a valid VkAccelerationStructureKHR: no live "
-                          "acceleration structure of this device has this handle.",
-                          reinterpret_cast<uint64_t>(info.srcAccelerationStructure));
+      skip |= ReportInvalidSource(ctx, cmd, i);
     } else if (!cmd.is_host() && info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
       skip |= ValidateBound(ctx, cmd, i, *src, "pInfos-03708", "srcAccelerationStructure");
     }
@@ -199,16 +217,53 @@ bool ValidateDistinctHandlesMany(const CheckContext& ctx, const BuildCommand& cm
 
 }  // namespace
 
-bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
-  if (!cmd.infos) return false;
+namespace {
+
+// Whether ValidateInfoHandles certainly has nothing to report or count for pInfos[i]: a live destination of the
+// build's type (or GENERIC), bound before it was created (or a host build), and no source, or a live one that needs
+// no binding test or was bound before it was created. Only compares, so that a loop over clean infos needs no call
+// and no stack frame; any other info takes the rules, which report exactly as before.
+inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                             const ResolvedInfo& r) {
+  const AccelerationStructureState* dst = r.dst;
+  if (!dst) return false;
+  if ((info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR ||
+       info.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) &&
+      dst->type != info.type && dst->type != VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR) {
+    return false;
+  }
+  if (!cmd.is_host() && !dst->buffer_was_bound) return false;
+  if (info.srcAccelerationStructure == VK_NULL_HANDLE) return true;
+  if (!r.src) return false;
+  return cmd.is_host() || info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || r.src->buffer_was_bound;
+}
+
+// The per-info rules from pInfos[first] on, the first info that is not certainly clean, then the rules between
+// infos (out of line).
+[[gnu::noinline]] bool ValidateInfosFrom(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved,
+                                         uint32_t first) {
   bool skip = false;
-  for (uint32_t i = 0; i < cmd.info_count; ++i) skip |= ValidateInfoHandles(ctx, cmd, i, resolved.info(i));
+  for (uint32_t i = first; i < cmd.info_count; ++i) {
+    const ResolvedInfo& r = resolved.info(i);
+    if (!InfoHandlesClean(cmd, cmd.infos[i], r)) skip |= ValidateInfoHandles(ctx, cmd, i, r);
+  }
   if (cmd.info_count > kFewInfos) {
     skip |= ValidateDistinctHandlesMany(ctx, cmd);
   } else if (cmd.info_count > 1) {
     skip |= ValidateDistinctHandlesFew(ctx, cmd);
   }
   return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildHandles(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
+  if (!cmd.infos) return false;
+  // The clean infos first, by compares only: a one-info command of a clean info needs no call and no stack frame.
+  uint32_t i = 0;
+  while (i < cmd.info_count && InfoHandlesClean(cmd, cmd.infos[i], resolved.info(i))) ++i;
+  if (i == cmd.info_count && cmd.info_count <= 1) return false;
+  return ValidateInfosFrom(ctx, cmd, resolved, i);
 }
 
 }  // namespace asval

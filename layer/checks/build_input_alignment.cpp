@@ -79,14 +79,16 @@ bool ValidateIndirectArrays(const CheckContext& ctx, const BuildCommand& cmd) {
 
 }  // namespace
 
-bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
-  if (!cmd.infos || cmd.is_host()) return false;
+namespace {
+
+// The infos the command's geometry pass flagged for these rules, walked with the reporting judge (out of line:
+// the clean path only tests the flags).
+[[gnu::noinline]] bool WalkInputAlignment(const CheckContext& ctx, const BuildCommand& cmd,
+                                          const ResolvedBuild& resolved) {
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
   bool skip = false;
-  // Infos in which the command's geometry pass found nothing for these rules are not walked again.
-  const uint32_t walked = resolved.walks() & kWalkInputAlignment ? cmd.info_count : 0;
-  for (uint32_t i = 0; i < walked; ++i) {
+  for (uint32_t i = 0; i < cmd.info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
     if (!(resolved.info(i).walks & kWalkInputAlignment) || !GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
@@ -94,6 +96,17 @@ bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, co
       if (geometry) skip |= InputAlignmentRules(ctx, cmd, i, j, facts.Read(*geometry), judge);
     }
   }
+  return skip;
+}
+
+}  // namespace
+
+bool ValidateInputAlignment(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
+  if (!cmd.infos || cmd.is_host()) return false;
+  if (!(resolved.walks() & kWalkInputAlignment) && !cmd.is_indirect()) return false;  // before any call: no frame
+  bool skip = false;
+  // Infos in which the command's geometry pass found nothing for these rules are not walked again.
+  if (resolved.walks() & kWalkInputAlignment) skip |= WalkInputAlignment(ctx, cmd, resolved);
   if (cmd.is_indirect()) skip |= ValidateIndirectArrays(ctx, cmd);
   return skip;
 }

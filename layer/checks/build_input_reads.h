@@ -51,7 +51,8 @@ template <typename Visit>
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
       const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
       InputRead vertices{InputKind::kVertices, false, t.vertexData.deviceAddress, 1};
-      if (r && t.indexType == VK_INDEX_TYPE_NONE_KHR) {
+      // f.index_size is 0 exactly for VK_INDEX_TYPE_NONE_KHR (IndexTypeSize), and already loaded.
+      if (r && f.index_size == 0) {
         // primitiveCount x 3 vertices from primitiveOffset + vertexStride x firstVertex; the last one is read
         // for its format's size, not its stride.
         const VkDeviceSize last = SaturatingAdd(r->firstVertex, SaturatingMul(3, count) - 1);
@@ -61,7 +62,7 @@ template <typename Visit>
       }
       result |= visit(vertices);
       // Indexed vertices are fetched where the indices say; only the start is known without reading them.
-      if (t.indexType != VK_INDEX_TYPE_NONE_KHR && f.index_size > 0) {
+      if (f.index_size > 0) {
         InputRead indices{InputKind::kIndices, r != nullptr, t.indexData.deviceAddress, 1};
         if (r) indices.size = SaturatingAdd(offset, SaturatingMul(SaturatingMul(3, count), f.index_size));
         result |= visit(indices);
@@ -98,13 +99,27 @@ template <typename Visit>
 [[gnu::cold, gnu::noinline]] bool ReportInputRead(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                                                   uint32_t j, const InputRead& read);
 
+// The buffer that held the last read of a walk over an info's geometries (with kInputUsage): the geometries of a
+// build mostly read one vertex buffer, so a read that lies inside it is held without asking the memo. Exact: the
+// window is a copy of a memo entry that served kInputUsage, and every entry stays a right answer for the call (the
+// memo was synced at its start); a read outside it asks the memo as before.
+struct InputWindow {
+  KnownBuffer held;  // size 0 (nothing yet) holds nothing
+};
+
 // The reads of geometry f (with its range, or null for an indirect build), each in one buffer of `memo`'s
 // device with kInputUsage.
 template <typename Judge>
 [[gnu::always_inline]] inline bool InputReadRules(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, const GeometryFacts& f,
-                    const VkAccelerationStructureBuildRangeInfoKHR* range, BufferMemo& memo, const Judge& judge) {
+                    const VkAccelerationStructureBuildRangeInfoKHR* range, BufferMemo& memo, InputWindow& window,
+                    const Judge& judge) {
   return ForEachRead(f, range, [&](const InputRead& read) {
-    if (memo.Held(ctx.state, read.address, read.size, kInputUsage)) return false;
+    if (window.held.Holds(read.address, read.size == 0 ? 1 : read.size)) return false;
+    if (const KnownBuffer* held = memo.Held(ctx.state, read.address, read.size, kInputUsage)) {
+      window.held.base = held->base;
+      window.held.size = held->size;
+      return false;
+    }
     return judge.Broken([&] { return ReportInputRead(ctx, cmd, i, j, read); });
   });
 }

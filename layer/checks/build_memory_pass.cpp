@@ -15,6 +15,8 @@ bool ValidateBuildMemory(const CheckContext& ctx, const BuildCommand& cmd, const
   bool skip = false;
   if (aliasing && IsOneBuildAliasing(cmd)) {  // the common single build: no sweep to set up
     const ResolvedInfo& r = resolved.info(0);
+    // The clean single build (nothing either family reports or counts) before any call: no stack frame.
+    if ((!addresses || InfoAddressesClean(cmd, r)) && OneBuildAliasingClean(cmd, r)) return false;
     if (!r.sizes) CountUnknownState(ctx);  // the sizes of this build cannot be known
     if (addresses) skip |= ValidateInfoAddresses(ctx, cmd, 0, r, resolved.memo());
     return skip | ValidateOneBuildAliasing(ctx, cmd, r, resolved.memo(), resolved.thread());

@@ -115,8 +115,11 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
   return ReportLargestIndex(ctx, cmd, i, j, largest);
 }
 
-bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
-  if (!cmd.infos || !cmd.ranges || !(resolved.walks() & kWalkRanges)) return false;
+namespace {
+
+// The infos the command's geometry pass flagged for these rules, walked with the reporting judge (out of line:
+// the clean path only tests the flags).
+[[gnu::noinline]] bool WalkRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
   bool skip = false;
@@ -131,6 +134,13 @@ bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const
     }
   }
   return skip;
+}
+
+}  // namespace
+
+bool ValidateBuildRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
+  if (!cmd.infos || !cmd.ranges || !(resolved.walks() & kWalkRanges)) return false;
+  return WalkRanges(ctx, cmd, resolved);
 }
 
 }  // namespace asval

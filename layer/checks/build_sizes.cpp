@@ -66,7 +66,8 @@ bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGe
   }
 }
 
-bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+// Out of line: walked only for infos the geometry pass flagged.
+[[gnu::noinline]] bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   if (cmd.is_indirect() ? !cmd.max_primitive_counts || !cmd.max_primitive_counts[i] : !cmd.ranges || !cmd.ranges[i]) {
     return false;  // counts not given: another rule's business
@@ -119,7 +120,10 @@ bool ValidateDestinationSize(const CheckContext& ctx, const BuildCommand& cmd, u
 
 }  // namespace
 
-bool SignatureOfInfo(const BuildCommand& cmd, uint32_t i, BuildSignature* out) {
+namespace {
+
+// SignatureOfInfo, inline in SizesOfInfo (the resolution's lookup of every info).
+[[gnu::always_inline]] inline bool SignatureOf(const BuildCommand& cmd, uint32_t i, BuildSignature* out) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   out->build_type =
       cmd.is_host() ? VK_ACCELERATION_STRUCTURE_BUILD_TYPE_HOST_KHR : VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR;
@@ -137,6 +141,10 @@ bool SignatureOfInfo(const BuildCommand& cmd, uint32_t i, BuildSignature* out) {
   out->count_stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
   return true;
 }
+
+}  // namespace
+
+bool SignatureOfInfo(const BuildCommand& cmd, uint32_t i, BuildSignature* out) { return SignatureOf(cmd, i, out); }
 
 bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature) {
   const DeviceFeatures& f = state.features;
@@ -176,7 +184,7 @@ std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildComma
                                       BuildSizeCache::ThreadTable* table) {
   BuildSignature signature;
   BuildSizes sizes;
-  if (SignatureOfInfo(cmd, i, &signature)) {
+  if (SignatureOf(cmd, i, &signature)) {
     const bool found = table ? state.build_sizes.Find(signature, &sizes, *table) : state.build_sizes.Find(signature, &sizes);
     if (found) return sizes;
     if (SizeQueryIsValid(state, signature)) {
@@ -204,6 +212,7 @@ bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint3
 }
 
 bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r) {
+  if (InfoSizesClean(r)) return false;
   // Infos in which the command's geometry pass found nothing for pInfos-03801 are not walked again.
   const bool counts = (r.walks & kWalkInstanceCounts) && ValidateInstanceCounts(ctx, cmd, i);
   return counts | ValidateDestinationSize(ctx, cmd, i, r);

@@ -19,6 +19,13 @@ namespace asval {
 // pInfos-10126 / pInfos-03652 and pInfos-03801 for pInfos[i], all three commands.
 bool ValidateInfoSizes(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, const ResolvedInfo& r);
 
+// Whether ValidateInfoSizes certainly has nothing to report or count for pInfos[i]: the geometry pass found no
+// instance count to judge, and the destination is known and at least as large as the driver's size. Tested
+// before any call, so that the clean path needs no stack frame.
+inline bool InfoSizesClean(const ResolvedInfo& r) {
+  return !(r.walks & kWalkInstanceCounts) && r.sizes && r.dst && r.dst->size >= r.sizes->acceleration_structure_size;
+}
+
 [[gnu::cold, gnu::noinline]] bool ReportInstanceCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                                                       uint32_t j, uint32_t count, uint64_t limit);
 

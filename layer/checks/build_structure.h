@@ -37,32 +37,29 @@ class StructureGeometryRules {
         top_(cmd.infos[i].type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR),
         bottom_(cmd.infos[i].type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR),
         // Host-side primitive counts exist for direct and host builds; indirect counts live on the device.
-        ranges_(cmd.ranges ? cmd.ranges[i] : nullptr) {}
+        ranges_(cmd.ranges ? cmd.ranges[i] : nullptr),
+        // Other structure types have no type rule.
+        type_reported_(!top_ && !bottom_) {
+    if (bottom_) {
+      // The type every geometry of a bottom-level build must have: the first one's (the first non-null one: the
+      // walks skip null geometries, or stop at one). A first instance geometry breaks type-03791 itself.
+      const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+      for (uint32_t j = 0; j < info.geometryCount; ++j) {
+        if (const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j)) {
+          first_type_ = g->geometryType;
+          break;
+        }
+      }
+    }
+    // A geometry of this type breaks no type rule; any other is judged by TypeRules.
+    expected_ = top_ ? VK_GEOMETRY_TYPE_INSTANCES_KHR
+                     : first_type_ == VK_GEOMETRY_TYPE_INSTANCES_KHR ? VK_GEOMETRY_TYPE_TRIANGLES_KHR : first_type_;
+  }
 
   [[gnu::always_inline]] bool Geometry(uint32_t j, const GeometryFacts& f, const Judge& judge) {
     const VkGeometryTypeKHR type = f.geometry.geometryType;
-    if (j_seen_ == 0) first_type_ = type;
-    ++j_seen_;
     bool skip = false;
-    if (!type_reported_) {
-      const char* suffix = nullptr;
-      const char* why = nullptr;
-      if (top_ && type != VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-        suffix = "type-03789";
-        why = "is not VK_GEOMETRY_TYPE_INSTANCES_KHR, but the build is top-level.";
-      } else if (bottom_ && type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-        suffix = "type-03791";
-        why = "is not allowed in a bottom-level build.";
-      } else if (bottom_ && type != first_type_) {
-        suffix = "type-03792";
-        why = "differs from the geometryType of the info's first geometry: all geometries of a bottom-level build "
-              "must have the same type.";
-      }
-      if (suffix) {
-        skip |= judge.Broken([&] { return ReportGeometryType(ctx_, cmd_, i_, j, suffix, why); });
-        type_reported_ = true;
-      }
-    }
+    if (type != expected_ && !type_reported_) skip |= TypeRules(j, type, judge);
     skip |= GeometryDataRules(ctx_, cmd_, i_, j, f, judge);
     if (bottom_ && ranges_) {
       if (type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) triangles_ += ranges_[j].primitiveCount;
@@ -84,15 +81,35 @@ class StructureGeometryRules {
   }
 
  private:
+  // type-03789, 03791, 03792 for a geometry whose type is not expected_ (the first finding of an info only).
+  bool TypeRules(uint32_t j, VkGeometryTypeKHR type, const Judge& judge) {
+    const char* suffix = nullptr;
+    const char* why = nullptr;
+    if (top_ && type != VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+      suffix = "type-03789";
+      why = "is not VK_GEOMETRY_TYPE_INSTANCES_KHR, but the build is top-level.";
+    } else if (bottom_ && type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+      suffix = "type-03791";
+      why = "is not allowed in a bottom-level build.";
+    } else if (bottom_ && type != first_type_) {
+      suffix = "type-03792";
+      why = "differs from the geometryType of the info's first geometry: all geometries of a bottom-level build "
+            "must have the same type.";
+    }
+    if (!suffix) return false;
+    type_reported_ = true;
+    return judge.Broken([&] { return ReportGeometryType(ctx_, cmd_, i_, j, suffix, why); });
+  }
+
   const CheckContext& ctx_;
   const BuildCommand& cmd_;
   const uint32_t i_;
   const bool top_;
   const bool bottom_;
   const VkAccelerationStructureBuildRangeInfoKHR* const ranges_;
-  uint32_t j_seen_ = 0;
+  bool type_reported_;
   VkGeometryTypeKHR first_type_ = VK_GEOMETRY_TYPE_MAX_ENUM_KHR;
-  bool type_reported_ = false;
+  VkGeometryTypeKHR expected_;
   uint64_t triangles_ = 0;
   uint64_t aabbs_ = 0;
 };

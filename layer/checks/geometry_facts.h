@@ -20,18 +20,20 @@ struct GeometryFacts {
   // the all-zero row of VK_FORMAT_UNDEFINED, which no rule of theirs reads.
   const VertexFormatInfo& format;
   // Triangles: VkFormatProperties::bufferFeatures of vertexFormat (nullopt: the layer cannot ask); other types:
-  // nullopt, which no rule of theirs reads.
-  std::optional<VkFormatFeatureFlags> features;
+  // nullopt, which no rule of theirs reads. The reader's own copy (no per-geometry copy of it).
+  const std::optional<VkFormatFeatureFlags>& features;
   int index_size;  // triangles: IndexTypeSize(indexType); other types: 0
 };
 
 class GeometryFactsReader {
  public:
+  static constexpr std::optional<VkFormatFeatureFlags> kNoFeatures{};
+
   explicit GeometryFactsReader(const DeviceState& state) : state_(state) {}
 
   [[gnu::always_inline]] GeometryFacts Read(const VkAccelerationStructureGeometryKHR& g) {
     if (g.geometryType != VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
-      return GeometryFacts{g, VertexFormatFacts(VK_FORMAT_UNDEFINED), std::nullopt, 0};
+      return GeometryFacts{g, VertexFormatFacts(VK_FORMAT_UNDEFINED), kNoFeatures, 0};
     }
     const VkAccelerationStructureGeometryTrianglesDataKHR& tri = g.geometry.triangles;
     if (tri.vertexFormat != format_) {

@@ -34,6 +34,7 @@ uint8_t ScreenLoop(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
   const ScreeningJudge judge;
   StructureGeometryRules<ScreeningJudge> structure_rules(ctx, cmd, i);
   GeometryFactsReader reader(ctx.state);
+  InputWindow window;
   // Whether each family's rules found something (the screening rules return true then).
   bool structure_found = false, ranges_found = false, alignment_found = false, reads_found = false,
        counts_found = false;
@@ -49,7 +50,8 @@ uint8_t ScreenLoop(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
     if (addresses) {
       // A geometry with no primitives (or a maximum of 0) reads nothing.
       const bool reads = kDirect ? ranges[j].primitiveCount != 0 : max_counts[j] != 0;
-      if (reads) reads_found |= InputReadRules(ctx, cmd, i, j, facts, kDirect ? &ranges[j] : nullptr, *memo, judge);
+      if (reads) reads_found |= InputReadRules(ctx, cmd, i, j, facts, kDirect ? &ranges[j] : nullptr, *memo, window,
+                                                 judge);
       counts_found |= InstanceCountRule(ctx, cmd, i, j, facts, judge);
     }
   }
@@ -66,9 +68,11 @@ void ScreenGeometries(const CheckContext& ctx, const BuildCommand& cmd, uint32_t
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   r.walks = kWalkAll;
   if (cmd.is_host() || !GeometriesWalkable(ctx, info)) return;
-  const Families on{ctx.Enabled(kCheckStructure), ctx.Enabled(kCheckAlignment),
-                    memo != nullptr && ctx.Enabled(kCheckAddresses)};
-  const bool all_on = on.structure && on.alignment && on.addresses;
+  // The default settings (every family on) in one mask test; the flags one by one only for the others.
+  constexpr uint32_t kAll = kCheckStructure | kCheckAlignment | kCheckAddresses;
+  const bool all_on = memo != nullptr && (ctx.enabled_checks & kAll) == kAll;
+  const Families on{all_on || ctx.Enabled(kCheckStructure), all_on || ctx.Enabled(kCheckAlignment),
+                    all_on || (memo != nullptr && ctx.Enabled(kCheckAddresses))};
   // The counts the rules read: ppBuildRangeInfos[i] (direct builds), ppMaxPrimitiveCounts[i] (indirect builds).
   // Without them the families' own walks decide what is judged.
   if (cmd.is_indirect()) {

@@ -90,8 +90,4 @@ ResolvedBuild::ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, C
   }
 }
 
-ResolvedBuild::~ResolvedBuild() {
-  for (uint32_t k = 0; k < inline_count_; ++k) inline_.infos[k].~ResolvedInfo();
-}
-
 }  // namespace asval

@@ -69,7 +69,9 @@ class ResolvedBuild {
  public:
   // thread: this call's lease of the thread's data (memos, buffers), held for the whole validation.
   ResolvedBuild(const CheckContext& ctx, const BuildCommand& cmd, CheckThreadData& thread);
-  ~ResolvedBuild();
+  ~ResolvedBuild() {
+    for (uint32_t k = 0; k < inline_count_; ++k) inline_.infos[k].~ResolvedInfo();
+  }
   ResolvedBuild(const ResolvedBuild&) = delete;
   ResolvedBuild& operator=(const ResolvedBuild&) = delete;
 

@@ -12,16 +12,6 @@
 
 namespace asval {
 
-DispatchRegistry<InstanceData>& Instances() {
-  static DispatchRegistry<InstanceData> registry;
-  return registry;
-}
-
-DispatchRegistry<DeviceData>& Devices() {
-  static DispatchRegistry<DeviceData> registry;
-  return registry;
-}
-
 namespace {
 
 // The loader's link info for the next element of the chain (LoaderLayerInterface.md, "Layer Dispatch

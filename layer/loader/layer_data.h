@@ -58,8 +58,16 @@ inline CheckContext MakeCheckContext(const DeviceData& data) {
   return CheckContext{data.state, *data.reporter, data.instance->settings.enabled_checks};
 }
 
-DispatchRegistry<InstanceData>& Instances();
-DispatchRegistry<DeviceData>& Devices();
+// Inline, so that each hook tests the registry's initialization guard itself instead of calling a function
+// (one registry each: an inline function's static is shared by every translation unit).
+inline DispatchRegistry<InstanceData>& Instances() {
+  static DispatchRegistry<InstanceData> registry;
+  return registry;
+}
+inline DispatchRegistry<DeviceData>& Devices() {
+  static DispatchRegistry<DeviceData> registry;
+  return registry;
+}
 
 template <typename Handle>
 InstanceData* GetInstanceData(Handle handle) {

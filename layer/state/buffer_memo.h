@@ -64,8 +64,8 @@ class BufferMemo {
   // scratch, its destination's buffer): `hint` is the entry that answered it last (any value at first), tried
   // before everything else and updated. Any entry that serves is a right answer (every entry is valid for the
   // maps as they are), so a stale hint only costs the usual lookup.
-  bool HoldingHinted(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes, VkBufferUsageFlags usage,
-                     uint8_t& hint, KnownBuffer* out) {
+  [[gnu::always_inline]] bool HoldingHinted(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
+                                            VkBufferUsageFlags usage, uint8_t& hint, KnownBuffer* out) {
     if (hint < count_ && Serves(entries_[hint], address, bytes, usage)) {
       *out = entries_[hint];
       return true;

@@ -91,10 +91,6 @@ constexpr uint32_t kWrittenInPlaceFrom = 8;
 
 }  // namespace
 
-GeometryRecord::GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
-  Read(geometry, count, count_known);
-}
-
 void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
   type = geometry.geometryType;
   flags = geometry.flags;
@@ -107,12 +103,16 @@ void GeometryRecord::Read(const VkAccelerationStructureGeometryKHR& geometry, ui
     max_vertex = t.maxVertex;
     // The union's device and host members share storage: non-null either way reads as a non-zero address.
     has_transform = t.transformData.deviceAddress != 0;
+  } else {
+    vertex_format = VK_FORMAT_UNDEFINED;
+    index_type = VK_INDEX_TYPE_NONE_KHR;
+    max_vertex = 0;
+    has_transform = false;
   }
 }
 
 // Grows the array once and writes the records in place (the capacity was reserved): per geometry, push_back's
-// capacity test and its copy of the record cost more than the record itself; only the members a geometry sets
-// are written over the defaults.
+// capacity test and its copy of the record cost more than the record itself.
 void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& info,
                             const VkAccelerationStructureBuildRangeInfoKHR* info_ranges) {
   const std::size_t first = geometries_.size();
@@ -125,7 +125,7 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
   const std::size_t stride = info_ranges ? sizeof(VkAccelerationStructureBuildRangeInfoKHR) : 0;
   const bool known = info_ranges != nullptr;
   for (uint32_t j = 0; j < info.geometryCount; ++j, count += stride) {
-    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);  // resize wrote the defaults
+    out[j].Read(info.pGeometries[j], *reinterpret_cast<const uint32_t*>(count), known);
   }
 }
 
@@ -143,18 +143,8 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
       const std::size_t needed = geometries_.size() + info.geometryCount;
       if (needed > geometries_.capacity()) geometries_.reserve(std::max(needed, 2 * geometries_.capacity()));
     }
-    AsOp& op = ops_.emplace_back();  // in place: an AsOp is large, and most of it stays at its defaults
-    op.kind = OpKind::kBuild;
-    op.origin = origin;
-    op.origin.element = i;
-    op.src = info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
-                                                                           : VK_NULL_HANDLE;
-    op.dst = info.dstAccelerationStructure;
-    op.mode = info.mode;
-    op.flags = info.flags;
-    op.type = info.type;
-    op.geometry_count = info.geometryCount;
-    op.first_geometry = static_cast<uint32_t>(geometries_.size());
+    // In place, each member written once: an AsOp is large, and most of it stays at its defaults.
+    AsOp& op = ops_.emplace_back(origin, i, info, static_cast<uint32_t>(geometries_.size()));
     if (captured && captured[i] != 0) {
       op.capture_log = log;
       op.capture_info = captured[i] - 1;
@@ -174,11 +164,8 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
             geometries_.resize(op.first_geometry);
             break;
           }
-          GeometryRecord& record = geometries_.emplace_back(GeometryRecord(*geometry, 0, false));
-          if (info_ranges) {
-            record.primitive_count = info_ranges[j].primitiveCount;
-            record.primitive_count_known = true;
-          }
+          geometries_.push_back(
+              GeometryRecord(*geometry, info_ranges ? info_ranges[j].primitiveCount : 0, info_ranges != nullptr));
         }
       }
     }

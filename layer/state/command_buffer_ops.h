@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "memory_range.h"
@@ -52,23 +53,26 @@ struct OpOrigin {
 // "pInfos[0] of the 3rd vkCmdBuildAccelerationStructuresKHR in VkCommandBuffer 0x..." (allocates: reports only).
 std::string DescribeOrigin(const OpOrigin& origin);
 
-// One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769).
+// One geometry of a build, as an update must repeat it (VUIDs 03761..03767, 03769). No member initializers: the
+// batch's array grows by `resize` without writing anything (the default constructor is user-provided and empty),
+// and the constructor below and Read write every member.
 struct GeometryRecord {
-  GeometryRecord() = default;
-  // Reads one geometry of a build info; count_known is false for indirect builds. Every member is written
-  // once, in place (AppendBuilds emplaces it: no temporary record copied in).
-  GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
-  // The same over a record that holds the defaults (a default-constructed one): writes only what the geometry sets.
+  GeometryRecord() {}  // uninitialized: only for arrays whose records Read writes
+  // Reads one geometry of a build info; count_known is false for indirect builds.
+  GeometryRecord(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known) {
+    Read(geometry, count, count_known);
+  }
+  // Writes every member from one geometry (the triangle members of other types get their defaults).
   void Read(const VkAccelerationStructureGeometryKHR& geometry, uint32_t count, bool count_known);
 
-  VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-  VkGeometryFlagsKHR flags = 0;
-  VkFormat vertex_format = VK_FORMAT_UNDEFINED;  // triangles only
-  VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;  // triangles only
-  uint32_t max_vertex = 0;                       // triangles only
-  uint32_t primitive_count = 0;
-  bool has_transform = false;                    // triangles: transformData non-null
-  bool primitive_count_known = false;            // false for indirect builds (the count is on the device)
+  VkGeometryTypeKHR type;
+  VkGeometryFlagsKHR flags;
+  VkFormat vertex_format;       // triangles only (else VK_FORMAT_UNDEFINED)
+  VkIndexType index_type;       // triangles only (else VK_INDEX_TYPE_NONE_KHR)
+  uint32_t max_vertex;          // triangles only (else 0)
+  uint32_t primitive_count;
+  bool has_transform;           // triangles: transformData non-null (else false)
+  bool primitive_count_known;   // false for indirect builds (the count is on the device)
 
   friend bool operator==(const GeometryRecord& a, const GeometryRecord& b) {
     return a.type == b.type && a.flags == b.flags && a.vertex_format == b.vertex_format &&
@@ -77,6 +81,7 @@ struct GeometryRecord {
   }
   friend bool operator!=(const GeometryRecord& a, const GeometryRecord& b) { return !(a == b); }
 };
+static_assert(std::is_trivially_copyable_v<GeometryRecord>, "copied as bytes");
 
 enum class OpKind : uint8_t {
   kBuild,            // a build or update (mode says which) of dst
@@ -101,21 +106,38 @@ struct AsOp {
   // User-provided, so that value-initialization (emplace_back()) runs the member initializers only, without
   // zeroing the whole operation first.
   AsOp() {}
+  // A build or update of pInfos[element] of a build command recorded at `at`, whose geometries start at
+  // first_geometry in its batch: the build members written once, the others their defaults.
+  AsOp(const OpOrigin& at, uint32_t element, const VkAccelerationStructureBuildGeometryInfoKHR& info,
+       uint32_t first_geometry_index)
+      : mode(info.mode),
+        origin(at),
+        src(info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? info.srcAccelerationStructure
+                                                                         : VK_NULL_HANDLE),
+        dst(info.dstAccelerationStructure),
+        flags(info.flags),
+        type(info.type),
+        geometry_count(info.geometryCount),
+        first_geometry(first_geometry_index) {
+    origin.element = element;
+  }
 
+  // The members are ordered by size within the groups below, so that the operation has no padding but the
+  // origin's (152 bytes: the batch's array grows and the command buffers copy them).
   OpKind kind = OpKind::kBuild;
+  // kBuild: the geometries could not be read (a null ppGeometries[j], or neither array given with
+  // geometryCount > 0): an invalid build, reported by the structure family; what it leaves in dst is unknown.
+  bool geometries_unreadable = false;
+  VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;  // kBuild
   OpOrigin origin;
   VkAccelerationStructureKHR src = VK_NULL_HANDLE;  // build (updates), copy, serialize
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;  // build, copy, deserialize, write properties
 
   // kBuild
-  VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
   VkBuildAccelerationStructureFlagsKHR flags = 0;
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   uint32_t geometry_count = 0;
   uint32_t first_geometry = 0;  // index into the batch's geometries
-  // The geometries could not be read (a null ppGeometries[j], or neither array given with geometryCount > 0):
-  // an invalid build, reported by the structure family; what it leaves in dst is unknown.
-  bool geometries_unreadable = false;
   // The bytes this build read, captured when it executes (issue 12): capture_info is its index in
   // capture_log->infos; capture_log is null when the build was not captured. The log is kept alive by the
   // published recording that holds this operation (RecordedOps::capture_logs).
@@ -128,11 +150,12 @@ struct AsOp {
 
   // kWriteProperties
   VkQueryType query_type = VK_QUERY_TYPE_OCCLUSION;
-  VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
   uint32_t query = 0;                       // firstQuery + element
+  VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
 
   bool is_update() const { return kind == OpKind::kBuild && mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR; }
 };
+static_assert(sizeof(AsOp) == 152, "no padding but the origin's: see the member order");
 
 // A sequence of operations in execution order, with their geometries.
 class OpBatch {

@@ -135,6 +135,39 @@ TEST_CASE("type-03791 and type-03792: a bottom-level build with instances, or wi
         std::string::npos);
 }
 
+TEST_CASE("type-03791 and type-03792: only the first type a bottom-level build breaks is reported, at its geometry",
+          "[integration][structure][03791][03792]") {
+  CheckFixture f("structure");
+  Scene scene(f.device());
+  VkAccelerationStructureGeometryKHR triangles = scene.Triangles();
+  VkAccelerationStructureBuildGeometryInfoKHR info = Scene::Info(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, {});
+  info.geometryCount = 1;
+  info.pGeometries = &triangles;
+  scene.Prepare(info, {1});
+  const auto ranges = Ranges(3);
+  const auto expect_one = [&](const char* vuid, const char* where) {
+    f.monitor().Expect(vuid);
+    IssueOne(f.device(), Command::kDirect, info, ranges.data());
+    std::vector<Message> messages = f.monitor().Take();
+    REQUIRE(messages.size() == 1);
+    CHECK(messages[0].text.find(where) != std::string::npos);
+  };
+  // An instance geometry after triangles breaks 03791 (not 03792, though its type also differs from the first).
+  VkAccelerationStructureGeometryKHR later_instances[2] = {scene.Triangles(), scene.Instances()};
+  info.geometryCount = 2;
+  info.pGeometries = later_instances;
+  expect_one(kBottomNoInstances, "pInfos[0].pGeometries[1].geometryType (VK_GEOMETRY_TYPE_INSTANCES_KHR)");
+  // A first instance geometry breaks 03791 itself; the triangles after it are not reported (one finding per info).
+  VkAccelerationStructureGeometryKHR first_instances[2] = {scene.Instances(), scene.Triangles()};
+  info.pGeometries = first_instances;
+  expect_one(kBottomNoInstances, "pInfos[0].pGeometries[0].geometryType (VK_GEOMETRY_TYPE_INSTANCES_KHR)");
+  // AABBs, then triangles (03792), then instances: only the first finding.
+  VkAccelerationStructureGeometryKHR mixed[3] = {scene.Aabbs(), scene.Triangles(), scene.Instances()};
+  info.geometryCount = 3;
+  info.pGeometries = mixed;
+  expect_one(kBottomSameType, "pInfos[0].pGeometries[1].geometryType (VK_GEOMETRY_TYPE_TRIANGLES_KHR)");
+}
+
 TEST_CASE("type-03789..03792 valid twin: one instance geometry at the top, several AABB geometries at the bottom, "
           "stay silent",
           "[integration][structure][03789][03790][03791][03792]") {
