@@ -24,7 +24,7 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
 
   // A slab of at least `bytes`; nullopt when the device cannot give one (no host-visible coherent memory type,
   // out of memory): the capture is then skipped and counted.
-  bool Take(VkDeviceSize bytes, CaptureSlab* slab);
+  bool Take(VkDeviceSize bytes, CaptureSlab* slab) override;
   void Return(const CaptureSlab& slab) override;
   // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
   void Shutdown();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
 
 namespace asval {
@@ -13,19 +14,9 @@ constexpr VkDeviceSize kNoBytes = std::numeric_limits<VkDeviceSize>::max();
 constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);  // 24
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
 constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);                 // 48
-constexpr VkDeviceSize kAlignment = 16;
 
 VkDeviceSize Add(VkDeviceSize a, VkDeviceSize b) { return a > kNoBytes - b ? kNoBytes : a + b; }
 VkDeviceSize Mul(VkDeviceSize a, VkDeviceSize b) { return b != 0 && a > kNoBytes / b ? kNoBytes : a * b; }
-
-int IndexBytes(VkIndexType type) {
-  switch (type) {
-    case VK_INDEX_TYPE_UINT16: return 2;
-    case VK_INDEX_TYPE_UINT32: return 4;
-    case VK_INDEX_TYPE_NONE_KHR: return 0;
-    default: return -1;  // UINT8 and others: not captured yet
-  }
-}
 
 // One range to copy: from a device address into the capture log.
 struct Source {
@@ -39,15 +30,14 @@ struct Source {
 // reading), with the captured geometry's parameters rewritten for bytes that start there. False when the
 // geometry is not captured.
 bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerationStructureBuildRangeInfoKHR& r,
-                  CapturedGeometry* out, std::vector<Source>& sources, std::size_t geometry_index) {
-  (void)geometry_index;
+                  CapturedGeometry* out, std::vector<Source>& sources) {
   out->type = g.geometryType;
   out->range.primitiveCount = r.primitiveCount;
   const VkDeviceSize n = r.primitiveCount;
   if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
     const VertexFormatInfo& format = VertexFormatFacts(t.vertexFormat);
-    const int index_bytes = IndexBytes(t.indexType);
+    const int index_bytes = builder::IndexTypeBytes(t.indexType);  // the builder's: it reads them
     if (!format.decodable || index_bytes < 0) return false;
     out->vertex_format = t.vertexFormat;
     out->vertex_stride = t.vertexStride;
@@ -105,23 +95,6 @@ std::optional<AddressHit> CopyableBuffer(const DeviceState& state, VkDeviceAddre
   });
 }
 
-// Room for `size` bytes in the log; false when no slab could be had.
-bool Allocate(const CaptureContext& ctx, CaptureLog& log, VkDeviceSize size, CapturedBytes* where) {
-  const VkDeviceSize offset = (log.used_in_last_slab + kAlignment - 1) & ~(kAlignment - 1);
-  if (log.slabs.empty() || offset > log.slabs.back().size || size > log.slabs.back().size - offset) {
-    CaptureSlab slab;
-    if (!ctx.pool.Take(size, &slab)) return false;
-    log.slabs.push_back(slab);
-    log.used_in_last_slab = 0;
-    return Allocate(ctx, log, size, where);
-  }
-  where->slab = static_cast<uint32_t>(log.slabs.size() - 1);
-  where->offset = offset;
-  where->size = size;
-  log.used_in_last_slab = offset + size;
-  return true;
-}
-
 struct Copy {
   VkBuffer src;
   VkBuffer dst;
@@ -159,39 +132,34 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       !ctx.next.CmdPipelineBarrier) {
     return false;
   }
-  thread_local std::vector<Copy> copies;  // kept from call to call on this thread: no allocation per call
+  // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
+  thread_local std::vector<Copy> copies;
+  thread_local std::vector<CapturedGeometry> planned;  // no geometry data: only the range infos are captured
   copies.clear();
   for (uint32_t i = 0; i < info_count; ++i) {
     const uint32_t n = infos[i].geometryCount;
     if (n == 0 || !max_primitive_counts[i] || addresses[i] == 0) continue;
     if (captured.empty()) captured.assign(info_count, 0);
-    if (!recording.capture_log) recording.capture_log = std::make_shared<CaptureLog>(ctx.pool.shared_from_this());
-    CaptureLog& log = *recording.capture_log;
+    CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
     CapturedInfo entry;
     entry.indirect = true;
-    entry.first_geometry = static_cast<uint32_t>(log.geometries.size());
     entry.geometry_count = n;
     entry.indirect_stride = strides[i];
-    log.geometries.resize(log.geometries.size() + n);
-    log.max_primitive_counts.resize(log.geometries.size(), 0);
-    for (uint32_t j = 0; j < n; ++j) log.max_primitive_counts[entry.first_geometry + j] = max_primitive_counts[i][j];
     const VkDeviceSize bytes = Add(Mul(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
     const std::optional<AddressHit> hit = Add(log.bytes_captured, bytes) <= ctx.budget_bytes
                                               ? CopyableBuffer(ctx.state, addresses[i], bytes)
                                               : std::nullopt;
-    if (hit && Allocate(ctx, log, bytes, &entry.ranges)) {
-      entry.ranges.present = true;
-      copies.push_back(Copy{hit->buffer, log.slabs[entry.ranges.slab].buffer,
+    if (hit && log.Reserve(bytes, &entry.ranges)) {
+      copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
                             VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
-      log.bytes_captured = Add(log.bytes_captured, bytes);
       ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
       ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
     } else {
       entry.complete = false;
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
     }
-    log.infos.push_back(entry);
-    captured[i] = static_cast<uint32_t>(log.infos.size());
+    planned.assign(n, CapturedGeometry{});
+    captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
   }
   if (!copies.empty()) RecordCopies(ctx, cb, copies);
   return !captured.empty();
@@ -206,6 +174,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
   thread_local std::vector<Copy> copies;
   thread_local std::vector<Source> sources;
+  thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   copies.clear();
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
@@ -218,16 +187,14 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
-    if (!recording.capture_log) recording.capture_log = std::make_shared<CaptureLog>(ctx.pool.shared_from_this());
-    CaptureLog& log = *recording.capture_log;
+    CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
     CapturedInfo entry;
-    entry.first_geometry = static_cast<uint32_t>(log.geometries.size());
     entry.geometry_count = info.geometryCount;
-    log.geometries.resize(log.geometries.size() + info.geometryCount);
+    planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanGeometry(*g, info_ranges[j], &log.geometries[entry.first_geometry + j], sources, j);
+      entry.complete = g && PlanGeometry(*g, info_ranges[j], &planned[j], sources);
     }
     VkDeviceSize total = 0;
     for (const Source& s : sources) total = Add(total, s.size);
@@ -240,24 +207,20 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
       if (!entry.complete) break;
       const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
       if (!hit && s.optional) continue;
-      if (!hit || !Allocate(ctx, log, s.size, s.into)) {
+      if (!hit || !log.Reserve(s.size, s.into)) {
         entry.complete = false;
         break;
       }
-      s.into->present = true;
-      copies.push_back(Copy{hit->buffer, log.slabs[s.into->slab].buffer,
-                            VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
+      copies.push_back(Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
     }
     if (!entry.complete) {
       copies.resize(first_copy);
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
     } else {
-      log.bytes_captured = Add(log.bytes_captured, total);
       ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
       ctx.counters.bytes_captured.fetch_add(total, std::memory_order_relaxed);
     }
-    log.infos.push_back(entry);
-    captured[i] = static_cast<uint32_t>(log.infos.size());
+    captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
   if (!copies.empty()) RecordCopies(ctx, cb, copies);
   return !captured.empty();

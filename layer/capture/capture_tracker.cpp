@@ -37,18 +37,12 @@ VkFence CaptureTracker::TakeFence() {
 
 void CaptureTracker::Reserve(const SubmissionCaptures& captures) {
   std::lock_guard<std::recursive_mutex> order(processing_);
-  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
-    // Pending twice: the device writes the same capture bytes twice before they are read.
-    if (log->pending_submissions > 0) log->overlapped = true;
-    ++log->pending_submissions;
-  }
+  for (const std::shared_ptr<CaptureLog>& log : captures.logs) log->SubmissionStarted();
 }
 
 void CaptureTracker::Unreserve(const SubmissionCaptures& captures) {
   std::lock_guard<std::recursive_mutex> order(processing_);
-  for (const std::shared_ptr<CaptureLog>& log : captures.logs) {
-    if (--log->pending_submissions == 0) log->overlapped = false;
-  }
+  for (const std::shared_ptr<CaptureLog>& log : captures.logs) log->SubmissionEnded();
 }
 
 void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence, SubmissionCaptures&& captures) {
@@ -88,9 +82,7 @@ void CaptureTracker::FenceRetired(VkFence app_fence) {
 
 // With the processing lock held.
 void CaptureTracker::Retire(Pending& p) {
-  for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) {
-    if (--log->pending_submissions == 0) log->overlapped = false;
-  }
+  for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) log->SubmissionEnded();
   if (!p.fence) return;
   next_.ResetFences(device_, 1, &p.fence);
   free_fences_.push_back(p.fence);

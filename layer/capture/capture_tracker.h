@@ -60,7 +60,7 @@ class CaptureTracker {
   // their layer fence); stops at the first one still pending. A call made while this thread is processing (from
   // an app callback) does nothing.
   void Process(const Covered& covered, const OnComplete& on_complete);
-  // No submission pending (one relaxed load: asked at every submission and wait).
+  // No submission pending (one atomic load: asked at every submission and wait).
   bool idle() const { return pending_count_.load(std::memory_order_acquire) == 0; }
 
  private:
@@ -76,7 +76,7 @@ class CaptureTracker {
   const VkDevice device_;
   const DeviceDispatchTable& next_;
   mutable std::mutex mutex_;          // pending_, free_fences_
-  // One thread processes at a time, in order; also guards the logs' pending_submissions and overlapped.
+  // One thread processes at a time, in order; also guards the logs' pending submissions.
   std::recursive_mutex processing_;
   std::deque<Pending> pending_;
   std::atomic<std::size_t> pending_count_{0};

@@ -5,6 +5,8 @@
 #include <array>
 #include <string>
 
+#include "build_report.h"
+
 namespace asval {
 
 namespace {
@@ -12,12 +14,8 @@ namespace {
 // Primitives named in a message; the rest are counted.
 constexpr std::size_t kNamed = 8;
 
-std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
-
 std::string Vuid(const ActivityComparison& c, const char* suffix) {
-  return fmt::format("VUID-{}-{}",
-                     c.device_build ? "vkCmdBuildAccelerationStructuresKHR" : "vkCmdBuildAccelerationStructuresIndirectKHR",
-                     suffix);
+  return fmt::format("VUID-{}-{}", OpCommandName(c.update.command), suffix);
 }
 
 std::string Named(const std::array<builder::ActivityChange, kNamed>& changes, std::size_t reported, bool became_active,

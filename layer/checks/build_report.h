@@ -13,6 +13,9 @@
 
 namespace asval {
 
+// A handle as messages write it: "0x1a2b".
+inline std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
+
 // For findings about the command as a whole rather than one element of pInfos.
 inline constexpr uint32_t kNoInfo = UINT32_MAX;
 

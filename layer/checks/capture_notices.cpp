@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
-#include <cstring>
 
 namespace asval {
 
@@ -34,8 +32,9 @@ void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity
 
 void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build) {
   const CaptureLog* log = build.log.get();
-  if (!log || build.info >= log->infos.size() || !log->infos[build.info].complete || log->overlapped) return;
-  const CapturedInfo& info = log->infos[build.info];
+  const CapturedInfo* readable = log ? log->Readable(build.info) : nullptr;
+  if (!readable) return;
+  const CapturedInfo& info = *readable;
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present) continue;
@@ -43,13 +42,9 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
     uint32_t count = 0, first = 0;
     int element = -1;
     for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
-      for (int e = 0; e < 12; ++e) {
-        float value;
-        std::memcpy(&value, bytes + k * sizeof(VkAccelerationStructureInstanceKHR) + 4 * e, sizeof(value));
-        if (std::isfinite(value)) continue;
-        if (count++ == 0) first = k, element = e;
-        break;
-      }
+      // The transform is the record's first member.
+      const int e = FirstNonFiniteElement(bytes + k * sizeof(VkAccelerationStructureInstanceKHR));
+      if (e >= 0 && count++ == 0) first = k, element = e;
     }
     if (count == 0) continue;
     ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, Location(OpCommandName(build.build.command)),

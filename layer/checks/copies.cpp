@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "build_report.h"
 #include "history_apply.h"
 #include "vk_enum_string.h"
 
@@ -12,8 +13,6 @@ namespace asval {
 namespace {
 
 constexpr VkDeviceSize kSerializedDataAlignment = 256;  // pInfo-03740 / pInfo-03743
-
-std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
 
 void CountUnknown(const CheckContext& ctx) {
   ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);

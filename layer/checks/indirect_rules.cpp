@@ -5,24 +5,24 @@
 #include <cstring>
 #include <string>
 
+#include "build_report.h"
+
 namespace asval {
 
 namespace {
 
 constexpr uint32_t kNamed = 4;  // geometries named in a message; the rest are counted
 
-std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
-
 }  // namespace
 
 void CheckIndirectRanges(const CheckContext& ctx, const IndirectRangeCheck& c) {
   const CaptureLog* log = c.log.get();
-  if (!log || c.info >= log->infos.size() || log->overlapped || !log->infos[c.info].complete ||
-      !log->infos[c.info].ranges.present) {
+  const CapturedInfo* readable = log ? log->Readable(c.info) : nullptr;
+  if (!readable || !readable->ranges.present) {
     ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  const CapturedInfo& info = log->infos[c.info];
+  const CapturedInfo& info = *readable;
   const uint8_t* ranges = log->Bytes(info.ranges);
   uint32_t over = 0;
   std::string named;

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <string>
 
+#include "build_report.h"
+
 namespace asval {
 
 namespace {
@@ -12,8 +14,6 @@ namespace {
 constexpr std::size_t kNamed = 4;  // references named in a message; the rest are counted
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);
 constexpr std::size_t kReferenceOffset = offsetof(VkAccelerationStructureInstanceKHR, accelerationStructureReference);
-
-std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
 
 [[gnu::cold]] void Report(const CheckContext& ctx, const InstanceReferenceCheck& c, uint32_t geometry, uint64_t bad,
                           const std::string& named) {
@@ -33,11 +33,12 @@ std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_c
 
 void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& c) {
   const CaptureLog* log = c.log.get();
-  if (!log || !c.live || c.info >= log->infos.size() || !log->infos[c.info].complete || log->overlapped) {
+  const CapturedInfo* readable = log ? log->Readable(c.info) : nullptr;
+  if (!readable || !c.live) {
     ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  const CapturedInfo& info = log->infos[c.info];
+  const CapturedInfo& info = *readable;
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0 || !g.data.present) continue;

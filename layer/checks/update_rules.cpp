@@ -2,14 +2,13 @@
 
 #include <fmt/format.h>
 
+#include "build_report.h"
 #include "layer_settings.h"
 #include "vk_enum_string.h"
 
 namespace asval {
 
 namespace {
-
-std::string Hex(const void* handle) { return fmt::format("0x{:x}", reinterpret_cast<uintptr_t>(handle)); }
 
 std::string BuildFlagsText(VkBuildAccelerationStructureFlagsKHR flags) {
   char buf[512];

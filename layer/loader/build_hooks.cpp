@@ -21,7 +21,7 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
                                  std::vector<uint32_t>& captured) {
   if (!data.capture_tracker || !infos) return nullptr;
   bool any = false;
-  for (uint32_t i = 0; i < info_count && !any; ++i) any = NeedsCapture(data.capture_mode, infos[i]);
+  for (uint32_t i = 0; i < info_count && !any; ++i) any = NeedsCapture(data.instance->settings.capture, infos[i]);
   if (!any) return nullptr;
   const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
   if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown

@@ -137,9 +137,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   // Execution-time capture: needs the history (its records live there).
-  data->capture_mode = instance->settings.capture;
-  data->capture_budget = VkDeviceSize{instance->settings.capture_budget_mb} << 20;
-  if (data->state.history_tracked && data->capture_mode != kCaptureOff) {
+  if (data->state.history_tracked && instance->settings.capture != kCaptureOff) {
     data->capture_pool = std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory);
     data->capture_tracker = std::make_unique<CaptureTracker>(*pDevice, data->dispatch);
   }

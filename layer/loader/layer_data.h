@@ -37,16 +37,15 @@ struct DeviceData {
   DeviceState state;
   // Execution-time capture (layer/capture): null when the capture setting is off or the history is not tracked.
   // The tracker is destroyed before the pool (declaration order).
-  CaptureMode capture_mode = kCaptureOff;
-  VkDeviceSize capture_budget = 0;
   std::shared_ptr<CapturePool> capture_pool;
   std::unique_ptr<CaptureTracker> capture_tracker;
 };
 
 // What the capture's pre-record of a build sees.
 inline CaptureContext MakeCaptureContext(DeviceData& data) {
-  return CaptureContext{data.state, data.dispatch, *data.capture_pool, data.capture_mode, data.capture_budget,
-                        data.state.capture_counters};
+  const LayerSettings& settings = data.instance->settings;
+  return CaptureContext{data.state, data.dispatch, *data.capture_pool, settings.capture,
+                        VkDeviceSize{settings.capture_budget_mb} << 20, data.state.capture_counters};
 }
 
 // Processes the submissions with captures that completed (or that `covered` names: the app's wait saw them

@@ -54,28 +54,31 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   return result.status == builder::ClassifyStatus::Ok && result.unreadable == 0 && !result.indexHashPartial;
 }
 
-// The first NaN or infinite element of a captured transform (row * 4 + column), or -1.
+// The first NaN or infinite element of a geometry's captured transform, or -1 (none, or not captured).
 int NonFiniteElement(const CaptureLog& log, const CapturedGeometry& g) {
-  if (!g.transform.present) return -1;
-  const uint8_t* bytes = log.Bytes(g.transform);
+  return g.transform.present ? FirstNonFiniteElement(log.Bytes(g.transform)) : -1;
+}
+
+}  // namespace
+
+int FirstNonFiniteElement(const uint8_t* matrix) {
   for (int k = 0; k < 12; ++k) {
     float value;
-    std::memcpy(&value, bytes + 4 * k, sizeof(value));
+    std::memcpy(&value, matrix + 4 * k, sizeof(value));
     if (!std::isfinite(value)) return k;
   }
   return -1;
 }
 
-}  // namespace
-
 void BuildActivity::Fill() {
   if (status_ != Status::kPending) return;
   const CaptureLog* log = log_.get();
-  if (!log || log->overlapped || info_ >= log->infos.size() || !log->infos[info_].complete) {
+  const CapturedInfo* readable = log ? log->Readable(info_) : nullptr;
+  if (!readable) {
     MarkUnknown();
     return;
   }
-  const CapturedInfo& info = log->infos[info_];
+  const CapturedInfo& info = *readable;
   if (info.indirect) {  // only its range infos were captured: what it built from is not known
     MarkUnknown();
     return;

@@ -19,6 +19,10 @@
 
 namespace asval {
 
+// The first NaN or infinite element of a 3x4 row-major float matrix as captured (VkTransformMatrixKHR, the
+// transform of an instance record), as row * 4 + column; -1 when all twelve are finite.
+int FirstNonFiniteElement(const uint8_t* matrix);
+
 class BuildActivity {
  public:
   enum class Status : uint8_t { kPending, kReady, kUnknown };
@@ -47,7 +51,6 @@ class BuildActivity {
     status_ = Status::kUnknown;
     log_.reset();
   }
-  const CaptureLog* log() const { return log_.get(); }
   // The build (or update) this is the activity of.
   const OpOrigin& origin() const { return origin_; }
   VkAccelerationStructureKHR dst() const { return dst_; }
@@ -72,7 +75,6 @@ struct ActivityComparison {
   OpOrigin source_build;                  // the build that produced `before` (for messages)
   VkAccelerationStructureKHR src = VK_NULL_HANDLE;
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
-  bool device_build = true;  // vkCmdBuildAccelerationStructuresKHR (else the indirect command): names the VUIDs
 };
 
 // A top-level build whose instances' references must name structures alive when it was submitted (06707).
@@ -98,7 +100,7 @@ struct SubmissionCaptures {
   std::vector<ActivityComparison> comparisons;
   std::vector<InstanceReferenceCheck> instance_checks;
   std::vector<IndirectRangeCheck> indirect_checks;
-  // The recordings whose captures this submission reads (each counted once in pending_submissions).
+  // The recordings whose captures this submission reads (each counted once as pending: CaptureLog::SubmissionStarted).
   std::vector<std::shared_ptr<CaptureLog>> logs;
   // Each capture read once per submission (history_apply.cpp).
   std::map<std::pair<const CaptureLog*, uint32_t>, BuildActivity*> claimed;

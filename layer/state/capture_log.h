@@ -9,6 +9,7 @@
 // processing lock (CaptureTracker, layer/capture).
 #include <vulkan/vulkan.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -45,6 +46,8 @@ struct CaptureSlab {
 class CaptureSlabOwner {
  public:
   virtual ~CaptureSlabOwner() = default;
+  // A slab of at least `bytes`; false when none can be had (the capture is then skipped and counted).
+  virtual bool Take(VkDeviceSize bytes, CaptureSlab* slab) = 0;
   virtual void Return(const CaptureSlab& slab) = 0;
 };
 
@@ -94,23 +97,48 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   CaptureLog& operator=(const CaptureLog&) = delete;
 
   const uint8_t* Bytes(const CapturedBytes& bytes) const { return slabs[bytes.slab].mapped + bytes.offset; }
+  // The slab's buffer the device copies `bytes` into.
+  VkBuffer BufferOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].buffer; }
+
+  // ---- written by the recording thread (layer/capture's pre-record, through these) ----
+  // Room for `size` bytes, 16-aligned, in the last slab or a new one; *where is set and marked present. False
+  // when no slab could be had.
+  bool Reserve(VkDeviceSize size, CapturedBytes* where);
+  // Appends one captured info with its geometries (and, for an indirect info, the recorded maximum counts, one
+  // per geometry; else null); `bytes` of its captures count against the recording's budget. Returns its index
+  // in `infos` plus one (what AsOp::capture_info is taken from).
+  uint32_t AddInfo(CapturedInfo entry, const CapturedGeometry* info_geometries, const uint32_t* max_counts,
+                   VkDeviceSize bytes);
+
+  // ---- under the capture processing lock (CaptureTracker) ----
+  // A submission that reads this recording's captures is about to be made / was processed or not made. A second
+  // one while the first is pending (a SIMULTANEOUS_USE command buffer) makes the device write the same bytes
+  // twice before the layer reads them: every capture of the recording is then unknown until none is pending.
+  void SubmissionStarted() {
+    if (pending_submissions_ > 0) overlapped_ = true;
+    ++pending_submissions_;
+  }
+  void SubmissionEnded() {
+    if (--pending_submissions_ == 0) overlapped_ = false;
+  }
+  bool overlapped() const { return overlapped_; }
+  // infos[info] when its bytes can be read as the device wrote them: every geometry captured, and not written
+  // again before being read; else null (the rules that need it are skipped and counted).
+  const CapturedInfo* Readable(uint32_t info) const {
+    return !overlapped_ && info < infos.size() && infos[info].complete ? &infos[info] : nullptr;
+  }
 
   std::vector<CaptureSlab> slabs;
-  VkDeviceSize used_in_last_slab = 0;
   VkDeviceSize bytes_captured = 0;
   std::vector<CapturedInfo> infos;
   std::vector<CapturedGeometry> geometries;
   std::vector<uint32_t> max_primitive_counts;  // parallel to geometries (indirect infos only; else 0)
 
-  // Submissions of this recording not yet processed (CaptureTracker, under its processing lock, which the readers
-  // of the bytes hold too). A second one while the
-  // first is pending (a SIMULTANEOUS_USE command buffer) makes the device write the same bytes twice before the
-  // layer reads them: every capture of the recording is then unknown until none is pending.
-  uint32_t pending_submissions = 0;
-  bool overlapped = false;
-
  private:
   std::shared_ptr<CaptureSlabOwner> owner_;
+  VkDeviceSize used_in_last_slab_ = 0;
+  uint32_t pending_submissions_ = 0;
+  bool overlapped_ = false;
 };
 
 }  // namespace asval

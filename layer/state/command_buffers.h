@@ -55,6 +55,11 @@ class CommandBufferState {
   // secondaries' recordings.
   std::shared_ptr<CaptureLog> capture_log;
   std::vector<std::shared_ptr<CaptureLog>> executed_capture_logs;
+  // The recording's capture log, made on its first capture with slabs from `owner`.
+  CaptureLog& CaptureLogFor(const std::shared_ptr<CaptureSlabOwner>& owner) {
+    if (!capture_log) capture_log = std::make_shared<CaptureLog>(owner);
+    return *capture_log;
+  }
   // 1-based ordinal of the next call of `command`, for messages ("the 3rd vkCmd...").
   uint32_t NextOrdinal(OpCommand command) { return ++calls_[static_cast<std::size_t>(command)]; }
   // vkBeginCommandBuffer, vkResetCommandBuffer, vkResetCommandPool: empty recording, nothing published.

@@ -146,7 +146,6 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     comparison.update = op.origin;
     comparison.src = op.src;
     comparison.dst = op.dst;
-    comparison.device_build = op.origin.command != OpCommand::kCmdBuildIndirect;
     captures.comparisons.push_back(std::move(comparison));
   }
   return node;

@@ -18,6 +18,7 @@ constexpr const char* kOverMaximum = "VUID-vkCmdBuildAccelerationStructuresIndir
 // Host memory standing in for a slab (never given back to a pool).
 class HostSlabs : public CaptureSlabOwner {
  public:
+  bool Take(VkDeviceSize, CaptureSlab*) override { return false; }
   void Return(const CaptureSlab&) override {}
 };
 
@@ -72,7 +73,8 @@ TEST_CASE("indirect capture unit: range infos over ppMaxPrimitiveCounts are repo
 TEST_CASE("indirect capture unit: range infos the layer cannot vouch for are skipped and counted", "[unit][capture]") {
   RecordHarness h;
   IndirectLog overlapped({11}, {10}, 16);
-  overlapped.log->overlapped = true;  // written twice before it was read
+  overlapped.log->SubmissionStarted();  // pending twice: written twice before it was read
+  overlapped.log->SubmissionStarted();
   IndirectLog missing({11}, {10}, 16);
   missing.log->infos[0].ranges.present = false;  // no buffer the layer could copy from
   for (IndirectLog* log : {&overlapped, &missing}) {

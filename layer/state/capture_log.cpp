@@ -1,0 +1,41 @@
+#include "capture_log.h"
+
+namespace asval {
+
+namespace {
+
+constexpr VkDeviceSize kAlignment = 16;
+
+}  // namespace
+
+bool CaptureLog::Reserve(VkDeviceSize size, CapturedBytes* where) {
+  const VkDeviceSize offset = (used_in_last_slab_ + kAlignment - 1) & ~(kAlignment - 1);
+  if (slabs.empty() || offset > slabs.back().size || size > slabs.back().size - offset) {
+    CaptureSlab slab;
+    if (!owner_->Take(size, &slab)) return false;
+    slabs.push_back(slab);
+    used_in_last_slab_ = 0;
+    return Reserve(size, where);
+  }
+  where->slab = static_cast<uint32_t>(slabs.size() - 1);
+  where->offset = offset;
+  where->size = size;
+  where->present = true;
+  used_in_last_slab_ = offset + size;
+  return true;
+}
+
+uint32_t CaptureLog::AddInfo(CapturedInfo entry, const CapturedGeometry* info_geometries, const uint32_t* max_counts,
+                             VkDeviceSize bytes) {
+  entry.first_geometry = static_cast<uint32_t>(geometries.size());
+  geometries.insert(geometries.end(), info_geometries, info_geometries + entry.geometry_count);
+  if (max_counts) {
+    max_primitive_counts.resize(geometries.size(), 0);
+    std::copy(max_counts, max_counts + entry.geometry_count, max_primitive_counts.begin() + entry.first_geometry);
+  }
+  if (entry.complete) bytes_captured += bytes;
+  infos.push_back(entry);
+  return static_cast<uint32_t>(infos.size());
+}
+
+}  // namespace asval
