@@ -5,6 +5,7 @@
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
+#include "structure_memory.h"
 
 namespace asval {
 
@@ -121,6 +122,33 @@ void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vect
                               0, nullptr);
 }
 
+// The destinations of a build command of several infos, for the rules about its top-level infos' instances and
+// its other destinations (None-03407, dstAccelerationStructure-03706), judged once the instances are captured.
+// The bytes each build writes are its accelerationStructureSize, as the size cache holds it: the command's
+// validation has just looked it up (or asked the driver). A size or memory not known leaves the span unknown.
+void ResolveDestinations(const DeviceState& state, uint32_t info_count,
+                         const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                         std::vector<CommandDestination>& out) {
+  out.assign(info_count, CommandDestination{});
+  for (uint32_t i = 0; i < info_count; ++i) {
+    CommandDestination& d = out[i];
+    d.handle = infos[i].dstAccelerationStructure;
+    d.element = i;
+    const std::optional<StructureMemory> memory = MemoryOfStructure(state, d.handle);
+    if (!memory) continue;
+    d.address = memory->structure->device_address;
+    BuildSignature signature;
+    signature.info = &infos[i];
+    BuildSizes sizes;
+    if (!ranges[i] && infos[i].geometryCount != 0) continue;
+    signature.counts = ranges[i] ? &ranges[i][0].primitiveCount : nullptr;
+    signature.count_stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
+    if (infos[i].geometryCount != 0 && !state.build_sizes.Find(signature, &sizes)) continue;
+    if (std::optional<MemorySpan> span = memory->Span(sizes.acceleration_structure_size)) d.accessed = *span;
+  }
+}
+
 }  // namespace
 
 bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
@@ -175,7 +203,10 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
   thread_local std::vector<Copy> copies;
   thread_local std::vector<Source> sources;
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
+  thread_local std::vector<CommandDestination> destinations;
   copies.clear();
+  bool destinations_logged = false;
+  uint32_t first_destination = 0;
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
     if (!NeedsCapture(ctx.mode, info)) continue;
@@ -190,6 +221,16 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
     CapturedInfo entry;
     entry.geometry_count = info.geometryCount;
+    entry.element = i;
+    if (info_count > 1 && info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+      if (!destinations_logged) {  // once per command, shared by its top-level infos
+        ResolveDestinations(ctx.state, info_count, infos, ranges, destinations);
+        first_destination = log.AddDestinations(destinations.data(), info_count);
+        destinations_logged = true;
+      }
+      entry.first_destination = first_destination;
+      entry.destination_count = info_count;
+    }
     planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {

@@ -1,8 +1,13 @@
 #pragma once
-// A top-level build's instance references (pInfos-06707: each accelerationStructureReference is 0 or the device
-// address of a valid acceleration structure), judged when the submission that ran the build completes, on the
+// A top-level build's instance references, judged when the submission that ran the build completes, on the
 // instances the device really read (execution-time capture, layer/capture) against the structures alive when it
-// was submitted. Const: reports only; run under the device's capture processing lock.
+// was submitted:
+//   pInfos-06707                     each reference is 0 or the device address of a live structure
+//   pInfos-03709                     the buffer each referenced structure was created on is bound to memory
+//   None-03407                       no reference names another info's destination in the same command
+//   dstAccelerationStructure-03706   no referenced structure's memory overlaps the bytes the command writes for
+//                                    another info's destination
+// Const: reports only; run under the device's capture processing lock.
 #include "build_activity.h"
 #include "check_context.h"
 

@@ -38,4 +38,10 @@ uint32_t CaptureLog::AddInfo(CapturedInfo entry, const CapturedGeometry* info_ge
   return static_cast<uint32_t>(infos.size());
 }
 
+uint32_t CaptureLog::AddDestinations(const CommandDestination* command_destinations, uint32_t count) {
+  const auto first = static_cast<uint32_t>(destinations.size());
+  destinations.insert(destinations.end(), command_destinations, command_destinations + count);
+  return first;
+}
+
 }  // namespace asval

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "asval/builder/geometry_view.h"
+#include "memory_range.h"
 
 namespace asval {
 
@@ -74,10 +75,25 @@ struct CapturedGeometry {
   CapturedBytes transform;    // triangles with a transform: its 48 bytes (for the warnings only; optional)
 };
 
+// A destination of a build command that has a captured top-level info among several: what the rules about one
+// command's instances and its other destinations need (None-03407, dstAccelerationStructure-03706), as resolved
+// when the command was recorded (a destination cannot move while the build is pending).
+struct CommandDestination {
+  VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+  uint32_t element = 0;         // its index in pInfos
+  VkDeviceAddress address = 0;  // 0: unknown
+  MemorySpan accessed;          // the bytes this build writes (accelerationStructureSize); memory null: unknown
+};
+
 // One captured build info (pInfos[i] of a recorded build command).
 struct CapturedInfo {
   uint32_t first_geometry = 0;  // into CaptureLog::geometries
   uint32_t geometry_count = 0;
+  uint32_t element = 0;  // its index in pInfos
+  // Top-level infos of a command of several infos: the command's destinations (all of them, this info's own
+  // included) in CaptureLog::destinations; count 0 otherwise.
+  uint32_t first_destination = 0;
+  uint32_t destination_count = 0;
   // Indirect builds: the range infos read from pIndirectDeviceAddresses[i], geometry j's at j * indirect_stride,
   // and ppMaxPrimitiveCounts[i][j] as recorded (in max_primitive_counts, from first_geometry on).
   bool indirect = false;
@@ -109,6 +125,9 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   // in `infos` plus one (what AsOp::capture_info is taken from).
   uint32_t AddInfo(CapturedInfo entry, const CapturedGeometry* info_geometries, const uint32_t* max_counts,
                    VkDeviceSize bytes);
+  // Appends the destinations of the command being recorded; returns the index of the first (for
+  // CapturedInfo::first_destination).
+  uint32_t AddDestinations(const CommandDestination* command_destinations, uint32_t count);
 
   // ---- under the capture processing lock (CaptureTracker) ----
   // A submission that reads this recording's captures is about to be made / was processed or not made. A second
@@ -133,6 +152,7 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   std::vector<CapturedInfo> infos;
   std::vector<CapturedGeometry> geometries;
   std::vector<uint32_t> max_primitive_counts;  // parallel to geometries (indirect infos only; else 0)
+  std::vector<CommandDestination> destinations;
 
  private:
   std::shared_ptr<CaptureSlabOwner> owner_;

@@ -7,6 +7,7 @@
 #include <vulkan/vulkan.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -20,12 +21,17 @@ namespace asval {
 
 struct LiveStructureAddresses {
   std::vector<VkDeviceAddress> addresses;  // sorted
+  // structures[k] has addresses[k] (the record as it was when the snapshot was taken).
+  std::vector<std::shared_ptr<const AccelerationStructureState>> structures;
   // Every live structure's address is known (the layer could ask for them all): otherwise an address not found
   // may belong to a structure whose address the layer does not know, and nothing is concluded from its absence.
   bool complete = true;
-  bool Contains(VkDeviceAddress address) const {
-    return std::binary_search(addresses.begin(), addresses.end(), address);
+  // The index of the structure with this address, or -1.
+  std::ptrdiff_t Find(VkDeviceAddress address) const {
+    const auto it = std::lower_bound(addresses.begin(), addresses.end(), address);
+    return it != addresses.end() && *it == address ? it - addresses.begin() : -1;
   }
+  bool Contains(VkDeviceAddress address) const { return Find(address) >= 0; }
 };
 
 class LiveStructureAddressCache {
@@ -37,14 +43,18 @@ class LiveStructureAddressCache {
     const StampValue stamp = structures.stamp();
     if (cached_ && stamp == stamp_) return cached_;
     auto fresh = std::make_shared<LiveStructureAddresses>();
-    for (const auto& [handle, record] : structures.snapshot()) {
+    std::vector<std::shared_ptr<const AccelerationStructureState>> live;
+    for (auto& [handle, record] : structures.snapshot()) {
       if (!record || record->device_address == 0) {
         fresh->complete = false;
         continue;
       }
-      fresh->addresses.push_back(record->device_address);
+      live.push_back(std::move(record));
     }
-    std::sort(fresh->addresses.begin(), fresh->addresses.end());
+    std::sort(live.begin(), live.end(), [](const auto& a, const auto& b) { return a->device_address < b->device_address; });
+    fresh->addresses.reserve(live.size());
+    for (const auto& record : live) fresh->addresses.push_back(record->device_address);
+    fresh->structures = std::move(live);
     cached_ = std::move(fresh);
     stamp_ = stamp;
     return cached_;

@@ -6,6 +6,7 @@
 // handle value may be handed to a new buffer, which must never be taken for the structure's.
 #include <vulkan/vulkan.h>
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 
@@ -21,11 +22,12 @@ struct StructureMemory {
   bool bound() const { return buffer && buffer->bound && buffer->memory != VK_NULL_HANDLE; }
   // First byte of the structure in its VkDeviceMemory (only when bound()).
   VkDeviceSize memory_offset() const { return buffer->memory_offset + structure->offset; }
-  // The VkDeviceMemory bytes the structure occupies; nullopt when not bound (or the arithmetic overflows).
-  std::optional<MemorySpan> Span() const {
+  // The VkDeviceMemory bytes the structure occupies, or its first `accessed` bytes (what a build writes); nullopt
+  // when not bound (or the arithmetic overflows).
+  std::optional<MemorySpan> Span(VkDeviceSize accessed = ~VkDeviceSize{0}) const {
     if (!bound()) return std::nullopt;
     return ResolveMemorySpan(MemoryBinding{buffer->memory, buffer->memory_offset, true}, structure->offset,
-                             structure->size);
+                             std::min(structure->size, accessed));
   }
 };
 

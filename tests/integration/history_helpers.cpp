@@ -203,8 +203,8 @@ VkAccelerationStructureBuildSizesInfoKHR LargestSizes(vkkit::Device& device, con
 
 }  // namespace
 
-Blas::Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared)
-    : device_(device), procs_(device), inputs_(&inputs) {
+Blas::Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared, VkDeviceSize offset)
+    : device_(device), procs_(device), inputs_(&inputs), offset_(offset) {
   const VkAccelerationStructureBuildSizesInfoKHR sizes = LargestSizes(device, inputs);
   size_ = (sizes.accelerationStructureSize * 2 + 255) & ~VkDeviceSize{255};
   if (shared) {
@@ -222,7 +222,8 @@ Blas::Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared)
 void Blas::Create() {
   VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
   info.buffer = storage_buffer_;
-  info.size = size_;
+  info.offset = offset_;
+  info.size = size_ - offset_;
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   vkkit::Check(device_.CreateAccelerationStructureKHR(device_.handle(), &info, nullptr, &handle_),
                "vkCreateAccelerationStructureKHR");
@@ -248,13 +249,24 @@ void Blas::DestroyHandle() {
   handle_ = VK_NULL_HANDLE;
 }
 
-void Blas::Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
-                  VkAccelerationStructureKHR src) {
+void Blas::DestroyStorageBuffer() {
+  if (storage_.buffer) vkDestroyBuffer(device_.handle(), storage_.buffer, nullptr);
+  storage_.buffer = VK_NULL_HANDLE;  // ~Blas frees the memory only
+}
+
+BuildInfo Blas::Info(const Shape& shape, VkBuildAccelerationStructureModeKHR mode) const {
   BuildInfo b = MakeBuildInfo(shape, *inputs_);
   b.info.mode = mode;
-  b.info.srcAccelerationStructure = src;
+  b.info.srcAccelerationStructure = mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? handle_ : VK_NULL_HANDLE;
   b.info.dstAccelerationStructure = handle_;
   b.info.scratchData.deviceAddress = scratch_.address;
+  return b;
+}
+
+void Blas::Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
+                  VkAccelerationStructureKHR src) {
+  BuildInfo b = Info(shape, mode);
+  b.info.srcAccelerationStructure = src;
   procs_.CmdBuild(cb, 1, &b.info, &b.range_pointer);
 }
 
@@ -316,25 +328,43 @@ vkkit::Buffer Tlas::MakeInstances(const std::vector<const Blas*>& blases) {
   return buffer;
 }
 
-void Tlas::Record(VkCommandBuffer cb, const vkkit::Buffer& instances, uint32_t count,
-                  VkBuildAccelerationStructureModeKHR mode) {
-  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+BuildInfo Tlas::Info(const vkkit::Buffer& instances, uint32_t count, VkBuildAccelerationStructureModeKHR mode) const {
+  BuildInfo b;
+  VkAccelerationStructureGeometryKHR& geometry =
+      b.geometries.emplace_back(VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR});
   geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
   geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
   geometry.geometry.instances.data.deviceAddress = instances.address;
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  VkAccelerationStructureBuildGeometryInfoKHR& info = b.info;
+  info = VkAccelerationStructureBuildGeometryInfoKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
   info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
   info.mode = mode;
   info.srcAccelerationStructure = mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? as_.handle : VK_NULL_HANDLE;
   info.dstAccelerationStructure = as_.handle;
   info.geometryCount = 1;
-  info.pGeometries = &geometry;
+  info.pGeometries = b.geometries.data();
   info.scratchData.deviceAddress = scratch_.address;
-  VkAccelerationStructureBuildRangeInfoKHR range{};
+  VkAccelerationStructureBuildRangeInfoKHR& range = b.ranges.emplace_back();
   range.primitiveCount = count;
-  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
-  procs_.CmdBuild(cb, 1, &info, &ranges);
+  b.range_pointer = b.ranges.data();
+  return b;
+}
+
+void Tlas::Record(VkCommandBuffer cb, const vkkit::Buffer& instances, uint32_t count,
+                  VkBuildAccelerationStructureModeKHR mode) {
+  const BuildInfo b = Info(instances, count, mode);
+  procs_.CmdBuild(cb, 1, &b.info, &b.range_pointer);
+}
+
+void RecordBuilds(vkkit::Device& device, VkCommandBuffer cb, const std::vector<const BuildInfo*>& infos) {
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> all;
+  std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> ranges;
+  for (const BuildInfo* b : infos) {
+    all.push_back(b->info);
+    ranges.push_back(b->range_pointer);
+  }
+  Procs(device).CmdBuild(cb, static_cast<uint32_t>(all.size()), all.data(), ranges.data());
 }
 
 // ---- QueryPool -------------------------------------------------------------------------------------------------

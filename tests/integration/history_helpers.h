@@ -124,10 +124,11 @@ struct BuildInfo {
 BuildInfo MakeBuildInfo(const Shape& shape, const Inputs& inputs);
 
 // A structure with storage and scratch big enough for any Shape. `shared` places it in another structure's
-// storage buffer (at the same offset: the two alias) instead of a buffer of its own.
+// storage buffer (at `offset`, a multiple of 256: with 0 the two alias at the same address) instead of a buffer of
+// its own.
 class Blas {
  public:
-  Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared = nullptr);
+  Blas(vkkit::Device& device, const Inputs& inputs, const Blas* shared = nullptr, VkDeviceSize offset = 0);
   ~Blas();
   Blas(const Blas&) = delete;
   Blas& operator=(const Blas&) = delete;
@@ -147,6 +148,11 @@ class Blas {
   // Destroys the structure, not its storage: address() stays backed by the same memory (a driver that reads the
   // structures a top-level build's instances reference finds bytes there) but names no live structure.
   void DestroyHandle();
+  // Destroys the VkBuffer the structure was created on (its own storage), not its memory nor the structure: the
+  // handle stays alive on a buffer that is gone, address() stays backed by the same memory.
+  void DestroyStorageBuffer();
+  // The info Build/Update would record (dst, src and scratch set), for a call of several infos (RecordBuilds).
+  BuildInfo Info(const Shape& shape, VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR) const;
 
  private:
   void Create();
@@ -159,6 +165,7 @@ class Blas {
   vkkit::Buffer storage_;  // own storage (empty when shared)
   VkBuffer storage_buffer_ = VK_NULL_HANDLE;
   VkDeviceSize size_ = 0;
+  VkDeviceSize offset_ = 0;  // in the storage buffer
   vkkit::Buffer scratch_;
   VkAccelerationStructureKHR handle_ = VK_NULL_HANDLE;
   VkDeviceAddress address_ = 0;
@@ -174,6 +181,8 @@ class Tlas {
   vkkit::Buffer MakeInstances(const std::vector<const Blas*>& blases);
   void Record(VkCommandBuffer cb, const vkkit::Buffer& instances, uint32_t count,
               VkBuildAccelerationStructureModeKHR mode);
+  // The info Record would record, for a call of several infos (RecordBuilds).
+  BuildInfo Info(const vkkit::Buffer& instances, uint32_t count, VkBuildAccelerationStructureModeKHR mode) const;
   VkAccelerationStructureKHR handle() const { return as_.handle; }
 
  private:
@@ -182,6 +191,9 @@ class Tlas {
   vkkit::AccelerationStructure as_;
   vkkit::Buffer scratch_;
 };
+
+// One vkCmdBuildAccelerationStructuresKHR of all these infos, in this order.
+void RecordBuilds(vkkit::Device& device, VkCommandBuffer cb, const std::vector<const BuildInfo*>& infos);
 
 // A query pool of `count` queries of `type`, reset by vkCmdResetQueryPool in Reset().
 class QueryPool {
