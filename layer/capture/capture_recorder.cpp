@@ -78,11 +78,13 @@ bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerat
   }
   if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
     const VkAccelerationStructureGeometryInstancesDataKHR& in = g.geometry.instances;
-    // Arrays of pointers need the pointers read before the instances: not captured yet.
-    if (in.arrayOfPointers) return false;
+    // Arrays of pointers: the pointers only (their alignment is a rule); where they point is known on the device
+    // alone, so the records themselves, and with them the references and the activity, stay unknown.
+    out->array_of_pointers = in.arrayOfPointers == VK_TRUE;
     if (n == 0) return true;
     if (in.data.deviceAddress == 0) return false;
-    sources.push_back(Source{Add(in.data.deviceAddress, r.primitiveOffset), Mul(kInstanceBytes, n), &out->data});
+    const VkDeviceSize record_bytes = out->array_of_pointers ? sizeof(VkDeviceAddress) : kInstanceBytes;
+    sources.push_back(Source{Add(in.data.deviceAddress, r.primitiveOffset), Mul(record_bytes, n), &out->data});
     return true;
   }
   return false;

@@ -37,7 +37,7 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
   const CapturedInfo& info = *readable;
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
-    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present) continue;
+    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present || g.array_of_pointers) continue;
     const uint8_t* bytes = log->Bytes(g.data);
     uint32_t count = 0, first = 0;
     int element = -1;

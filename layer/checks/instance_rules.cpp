@@ -26,10 +26,18 @@ struct Referenced {
   uint32_t instance;
 };
 
-void Report(const CheckContext& ctx, const InstanceReferenceCheck& c, const char* rule,
+[[gnu::cold]] void Report(const CheckContext& ctx, const InstanceReferenceCheck& c, const char* rule,
             VkAccelerationStructureKHR referenced, const std::string& message) {
   const char* command = OpCommandName(c.build.command);
-  ctx.reporter.Report(Severity::kError, fmt::format("VUID-{}-{}", command, rule), Location(command),
+  const std::string vuid = fmt::format("VUID-{}-{}", command, rule);
+  if (referenced == VK_NULL_HANDLE) {
+    ctx.reporter.Report(Severity::kError, vuid, Location(command),
+                        {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, c.build.command_buffer),
+                         Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, c.dst)},
+                        message);
+    return;
+  }
+  ctx.reporter.Report(Severity::kError, vuid, Location(command),
                       {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, c.build.command_buffer),
                        Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, c.dst),
                        Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, referenced)},
@@ -66,32 +74,34 @@ bool StillTheSame(const DeviceState& state, const AccelerationStructureState& s)
   return now && *now && (*now)->device_address == s.device_address && (*now)->buffer_id == s.buffer_id;
 }
 
-// The rules about one structure the build's instances reference: its storage (03709) and, for a command of
-// several infos, the command's other destinations (None-03407, dstAccelerationStructure-03706). Returns the
-// findings made (for the cap).
-uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
-                         const CapturedInfo& info, const Referenced& r,
-                         const std::shared_ptr<const AccelerationStructureState>& structure) {
-  const AccelerationStructureState& s = *structure;
-  uint32_t findings = 0;
-  std::shared_ptr<const BufferState> buffer;
-  const bool known = s.buffer_id != 0 && StillTheSame(ctx.state, s);
-  if (!known) {
+// The buffer the referenced structure was created on, when it is still bound to memory; else null, and, when
+// `report`, pInfos-03709 reported (counted in *findings). Judged on the structure the snapshot saw, if it is still
+// that structure now (destroyed since: nothing concluded, counted).
+std::shared_ptr<const BufferState> BoundStorage(const CheckContext& ctx, const InstanceReferenceCheck& c,
+                                                const Referenced& r, const AccelerationStructureState& s, bool report,
+                                                uint32_t* findings) {
+  if (s.buffer_id == 0 || !StillTheSame(ctx.state, s)) {
     CountUnknownState(ctx);
-  } else {
-    buffer = BufferOfStructure(ctx.state, s);
-    if (!buffer) {
-      ReportStorageLost(ctx, c, r, s, "was destroyed");
-      ++findings;
-    } else if (!buffer->bound || buffer->memory == VK_NULL_HANDLE) {
-      ReportStorageLost(ctx, c, r, s, buffer->memory_freed ? "has had its memory freed" : "is bound to no memory");
-      ++findings;
-      buffer.reset();
-    }
+    return nullptr;
   }
-  // The whole structure: which of its bytes the build reads is the driver's business.
-  const std::optional<MemorySpan> referenced_span =
-      buffer ? StructureMemory{structure, buffer}.Span() : std::nullopt;
+  std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, s);
+  if (buffer && buffer->bound && buffer->memory != VK_NULL_HANDLE) return buffer;
+  if (report) {
+    ReportStorageLost(ctx, c, r, s,
+                      !buffer               ? "was destroyed"
+                      : buffer->memory_freed ? "has had its memory freed"
+                                             : "is bound to no memory");
+    ++*findings;
+  }
+  return nullptr;
+}
+
+// None-03407 and dstAccelerationStructure-03706: the referenced structure against the other destinations of the
+// call the build was recorded in. `span`: the structure's memory (null: unknown).
+uint32_t CheckAgainstDestinations(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
+                                  const CapturedInfo& info, const Referenced& r, const AccelerationStructureState& s,
+                                  const std::optional<MemorySpan>& span) {
+  uint32_t findings = 0;
   for (uint32_t d = 0; d < info.destination_count; ++d) {
     const CommandDestination& other = log.destinations[info.first_destination + d];
     if (other.element == info.element) continue;
@@ -102,13 +112,13 @@ uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& 
                          DescribeOrigin(c.build), Hex(c.dst), Referencing(r, s), other.element));
       ++findings;
     }
-    if (!referenced_span || other.accessed.memory == VK_NULL_HANDLE) {
+    if (!span || other.accessed.memory == VK_NULL_HANDLE) {
       CountUnknownState(ctx);
       continue;
     }
-    if (!Overlaps(*referenced_span, other.accessed)) continue;
-    const VkDeviceSize from = std::max(referenced_span->begin, other.accessed.begin);
-    const VkDeviceSize to = std::min(referenced_span->end, other.accessed.end);
+    if (!Overlaps(*span, other.accessed)) continue;
+    const VkDeviceSize from = std::max(span->begin, other.accessed.begin);
+    const VkDeviceSize to = std::min(span->end, other.accessed.end);
     Report(ctx, c, "dstAccelerationStructure-03706", s.handle,
            fmt::format("{}: builds top-level {}; on execution, {}, whose memory overlaps the bytes this command writes "
                        "for pInfos[{}].dstAccelerationStructure (VkAccelerationStructureKHR {}): {} bytes at "
@@ -118,6 +128,44 @@ uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& 
     ++findings;
   }
   return findings;
+}
+
+// The rules about one structure the build's instances reference (each family as the settings enable it).
+// Returns the findings made (for the cap).
+uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
+                         const CapturedInfo& info, const Referenced& r,
+                         const std::shared_ptr<const AccelerationStructureState>& structure) {
+  const bool storage = ctx.Enabled(kCheckHandles);
+  const bool destinations = ctx.Enabled(kCheckAliasing) && info.destination_count != 0;
+  if (!storage && !destinations) return 0;
+  uint32_t findings = 0;
+  const std::shared_ptr<const BufferState> buffer = BoundStorage(ctx, c, r, *structure, storage, &findings);
+  if (!destinations) return findings;
+  // The whole structure: which of its bytes the build reads is the driver's business.
+  const std::optional<MemorySpan> span = buffer ? StructureMemory{structure, buffer}.Span() : std::nullopt;
+  return findings + CheckAgainstDestinations(ctx, c, log, info, r, *structure, span);
+}
+
+// pInfos-03717: each pointer of an array of instance pointers is 16-byte aligned. The records the pointers
+// name are not captured: their references (and so the rules above) are unknown, counted.
+void CheckInstancePointers(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
+                           uint32_t geometry, const CapturedGeometry& g) {
+  CountUnknownState(ctx);
+  const uint8_t* bytes = log.Bytes(g.data);
+  uint64_t misaligned = 0;
+  std::string named;
+  for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
+    VkDeviceAddress pointer = 0;
+    std::memcpy(&pointer, bytes + static_cast<std::size_t>(k) * sizeof(pointer), sizeof(pointer));
+    if (pointer % 16 == 0) continue;
+    if (misaligned++ < kNamed) named += fmt::format("{}instance {} at 0x{:x}", misaligned > 1 ? ", " : "", k, pointer);
+  }
+  if (misaligned == 0) return;
+  if (misaligned > kNamed) named += fmt::format(" (and {} more)", misaligned - kNamed);
+  Report(ctx, c, "pInfos-03717", VK_NULL_HANDLE,
+         fmt::format("{}: builds top-level {}; on execution, geometry {} (arrayOfPointers): {} pointer(s) are not "
+                     "aligned to 16 bytes: {}.",
+                     DescribeOrigin(c.build), Hex(c.dst), geometry, misaligned, named));
 }
 
 }  // namespace
@@ -135,6 +183,10 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0 || !g.data.present) continue;
+    if (g.array_of_pointers) {
+      if (ctx.Enabled(kCheckAlignment)) CheckInstancePointers(ctx, c, *log, j, g);
+      continue;
+    }
     const uint8_t* bytes = log->Bytes(g.data);
     uint64_t bad = 0;
     bool unknown = false;

@@ -34,7 +34,8 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
     view.range = g.range;
     result = builder::ClassifyTriangles(view, record, nullptr);
   } else if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-    builder::InstanceGeometryView view;  // plain records (arrays of pointers are not captured)
+    if (g.array_of_pointers) return false;  // the pointers only: the records they point to are not captured
+    builder::InstanceGeometryView view;
     view.data = log.Bytes(g.data);
     view.dataBytes = g.data.size;
     view.range = g.range;

@@ -69,6 +69,9 @@ struct CapturedGeometry {
   uint32_t max_vertex = 0;
   VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
   VkDeviceSize aabb_stride = 0;
+  // Instances given as an array of pointers: `data` holds the pointers (8 bytes each) the device read, not the
+  // records they point to, which the layer cannot locate when it records the copies.
+  bool array_of_pointers = false;
   builder::BuildRange range;  // primitiveCount, and the offsets still to apply to the captured bytes
   CapturedBytes data;         // vertices (triangles) or AABB records
   CapturedBytes indices;      // indexed triangles
