@@ -169,7 +169,7 @@ std::string LastBuilt(const OpReporter& r, const BuildSnapshot& s) {
       }
     }
     if (!g.primitive_count_known || !b.primitive_count_known) {
-      r.CountSkip();  // an indirect build's count lives on the device
+      if (!op.counts_captured()) r.CountSkip();  // an indirect build's count lives on the device
     } else if (g.primitive_count != b.primitive_count) {
       r.Add(Severity::kError, r.CommandVuid("primitiveCount-03769"), op.src,
             fmt::format("{}the build range's primitiveCount is {}, but {} with primitiveCount {}.", at,
@@ -180,7 +180,8 @@ std::string LastBuilt(const OpReporter& r, const BuildSnapshot& s) {
 
 // The clean path: an update that repeats its source's last build compares equal and formats nothing.
 // *unknown_counts: geometries whose primitive count one side does not know (an indirect build's count lives
-// on the device); counted as skips by the caller, once (CompareUpdate counts them itself).
+// on the device); counted as skips by the caller, once (CompareUpdate counts them itself), unless the update's
+// counts are captured: the comparison is then made, or counted, when the update completes (indirect_rules.h).
 bool UpdateMatches(const OpReporter& r, const BuildSnapshot& s, uint32_t* unknown_counts) {
   const AsOp& op = r.op;
   if (!(s.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) || s.flags != op.flags || s.type != op.type ||
@@ -224,6 +225,7 @@ void CheckUpdate(const OpReporter& r) {
     CompareUpdate(r, *h->build);
     return;
   }
+  if (r.op.counts_captured()) return;
   for (uint32_t k = 0; k < unknown_counts; ++k) r.CountSkip();
 }
 

@@ -36,7 +36,7 @@ struct LayerSettings {
   // One field per setting, named after its key, initialised to the manifest default:
   //   uint32_t report_flags;                      LayerSettingFlagBits
   //   CaptureMode capture;                        kCaptureOff, kCaptureUpdates or kCaptureAll
-  //   uint32_t capture_budget_mb;                 per submission, 1..65536
+  //   uint32_t capture_budget_mb;                 per recording of a command buffer, 1..65536
   //   uint32_t duplicate_message_limit;           0 = unlimited
   //   std::vector<std::string> message_id_filter; VUIDs, VUID suffixes or message-id hashes, as written
   //   std::string report_file;                    JSON-lines report path, empty = none

@@ -86,12 +86,20 @@ struct InstanceReferenceCheck {
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
 };
 
-// An indirect build whose range infos, read by the device, must respect ppMaxPrimitiveCounts (03653).
+struct BuildSnapshot;  // history.h (which includes this file)
+
+// An indirect build whose range infos, read by the device, must respect ppMaxPrimitiveCounts (03653); for an
+// update, each geometry's primitiveCount must also be its source's last build's (primitiveCount-03769).
 struct IndirectRangeCheck {
   std::shared_ptr<const CaptureLog> log;
   uint32_t info = 0;
   OpOrigin build;
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+  // Updates: srcAccelerationStructure and its last build as the history held it when the update was applied
+  // (submission order; shared, immutable). Null for builds, and for updates whose source has no last build to
+  // compare with: never built (03667) or unknown, which the update rules reported or counted at submission.
+  VkAccelerationStructureKHR src = VK_NULL_HANDLE;
+  std::shared_ptr<const BuildSnapshot> source;
 };
 
 // What one submission's captures ask for once it completes, in submission order.

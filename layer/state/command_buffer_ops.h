@@ -154,6 +154,10 @@ struct AsOp {
   VkQueryPool query_pool = VK_NULL_HANDLE;  // null for host writes
 
   bool is_update() const { return kind == OpKind::kBuild && mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR; }
+  // An indirect build whose range infos the layer captures: its primitive counts are read when it executes, and
+  // an update's comparison of them (primitiveCount-03769) is judged, or counted as skipped, when its submission
+  // completes (layer/checks/indirect_rules.h), not at submission.
+  bool counts_captured() const { return origin.command == OpCommand::kCmdBuildIndirect && capture_log != nullptr; }
 };
 static_assert(sizeof(AsOp) == 152, "no padding but the origin's: see the member order");
 

@@ -108,6 +108,19 @@ void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h
   ClobberOverlapping(store, span, dst, op, txn);
 }
 
+// An indirect build's captured range infos, judged when its submission completes. An update takes its source's
+// last build now, in submission order (the store holds the source as it is before the update is applied): a
+// later submission may rebuild the source before this one completes. Sharing the snapshot allocates nothing.
+IndirectRangeCheck IndirectCheck(const HistoryStore& store, const AsOp& op, CaptureLog* log) {
+  IndirectRangeCheck check{log->shared_from_this(), op.capture_info, op.origin, op.dst};
+  if (op.is_update()) {
+    check.src = op.src;
+    const AsHistory* src = store.Find(op.src);
+    if (src && src->kind == HistoryKind::kBuilt) check.source = src->build;
+  }
+  return check;
+}
+
 // A captured build's activity, filled when its submission completes; an update's comparison with its source's.
 // The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
 // one call) holds the bytes of the last execution only: both are unknown.
@@ -126,7 +139,7 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
   if (!known_log) captures.logs.push_back(log->shared_from_this());
   captures.fills.push_back(node);
   if (op.origin.command == OpCommand::kCmdBuildIndirect) {
-    captures.indirect_checks.push_back(IndirectRangeCheck{log->shared_from_this(), op.capture_info, op.origin, op.dst});
+    captures.indirect_checks.push_back(IndirectCheck(store, op, log));
   }
   if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && op.origin.command != OpCommand::kCmdBuildIndirect) {
     InstanceReferenceCheck check;

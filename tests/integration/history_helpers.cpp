@@ -290,7 +290,7 @@ VkResult Blas::HostUpdate(const Shape& shape) {
 
 // ---- Tlas ------------------------------------------------------------------------------------------------------
 
-Tlas::Tlas(vkkit::Device& device) : device_(device), procs_(device) {
+Tlas::Tlas(vkkit::Device& device, uint32_t max_instances) : device_(device), procs_(device) {
   VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
   geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
   geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
@@ -299,7 +299,6 @@ Tlas::Tlas(vkkit::Device& device) : device_(device), procs_(device) {
   info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
   info.geometryCount = 1;
   info.pGeometries = &geometry;
-  const uint32_t max_instances = 4;
   VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
   device.GetAccelerationStructureBuildSizesKHR(device.handle(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
                                                &max_instances, &sizes);

@@ -171,11 +171,11 @@ class Blas {
   VkDeviceAddress address_ = 0;
 };
 
-// A top-level structure over instances of bottom-level structures, read from an instance buffer that the
-// caller may replace every frame.
+// A top-level structure over up to `max_instances` instances of bottom-level structures, read from an instance
+// buffer that the caller may replace every frame.
 class Tlas {
  public:
-  explicit Tlas(vkkit::Device& device);
+  explicit Tlas(vkkit::Device& device, uint32_t max_instances = 4);
   ~Tlas();
   // A new instance buffer referencing `blases` (one instance each).
   vkkit::Buffer MakeInstances(const std::vector<const Blas*>& blases);
