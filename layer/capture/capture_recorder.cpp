@@ -176,9 +176,10 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
     entry.geometry_count = n;
     entry.indirect_stride = strides[i];
     const VkDeviceSize bytes = Add(Mul(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
-    const std::optional<AddressHit> hit = Add(log.bytes_captured, bytes) <= ctx.budget_bytes
-                                              ? CopyableBuffer(ctx.state, addresses[i], bytes)
-                                              : std::nullopt;
+    const bool within_budget = Add(log.bytes_captured, bytes) <= ctx.budget_bytes;
+    if (!within_budget) ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
+    const std::optional<AddressHit> hit =
+        within_budget ? CopyableBuffer(ctx.state, addresses[i], bytes) : std::nullopt;
     if (hit && log.Reserve(bytes, &entry.ranges)) {
       copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
                             VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});

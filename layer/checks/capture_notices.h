@@ -23,6 +23,6 @@ void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity
 // After a captured top-level build completed: its instances' transforms.
 void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build);
 // After a build's pre-record: reports the budget once, the first time it was exceeded on this device.
-void ReportCaptureBudget(const CheckContext& ctx, uint32_t budget_mb);
+void ReportCaptureBudget(const CheckContext& ctx, uint32_t budget_mb, const char* command);
 
 }  // namespace asval

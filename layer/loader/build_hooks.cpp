@@ -27,7 +27,8 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
   if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown
   const bool any_captured =
       CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured);
-  ReportCaptureBudget(MakeCheckContext(data), data.instance->settings.capture_budget_mb);
+  ReportCaptureBudget(MakeCheckContext(data), data.instance->settings.capture_budget_mb,
+                      "vkCmdBuildAccelerationStructuresKHR");
   return any_captured ? captured.data() : nullptr;
 }
 
@@ -76,6 +77,8 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
                                 pIndirectDeviceAddresses, pIndirectStrides, ppMaxPrimitiveCounts, out)) {
         captured = out.data();
       }
+      ReportCaptureBudget(MakeCheckContext(*data), data->instance->settings.capture_budget_mb,
+                          "vkCmdBuildAccelerationStructuresIndirectKHR");
     }
   }
   data->dispatch.CmdBuildAccelerationStructuresIndirectKHR(commandBuffer, infoCount, pInfos, pIndirectDeviceAddresses,
