@@ -2,13 +2,17 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
+#include "build_report.h"
+
 
 namespace asval {
 
-void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity) {
+void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity, uint32_t warnings) {
   for (const BuildActivity::UndefinedInput& u : activity.undefined_input()) {
     const OpOrigin& origin = activity.origin();
-    if (u.transform_element >= 0) {
+    if (u.transform_element >= 0 && (warnings & kCaptureWarnNonFiniteTransform)) {
       ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, Location(OpCommandName(origin.command)),
                           {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, origin.command_buffer),
                            Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, activity.dst())},
@@ -18,7 +22,7 @@ void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity
                                       DescribeOrigin(origin), u.geometry, u.transform_element / 4,
                                       u.transform_element % 4));
     }
-    if (u.primitives == 0) continue;
+    if (u.primitives == 0 || !(warnings & kCaptureWarnUndefinedInput)) continue;
     ctx.reporter.Report(
         Severity::kWarning, kUndefinedInputId, Location(OpCommandName(origin.command)),
         {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, origin.command_buffer),
@@ -28,6 +32,36 @@ void ReportUndefinedInput(const CheckContext& ctx, const BuildActivity& activity
                     "build's result undefined (first: primitive {}).",
                     DescribeOrigin(origin), u.geometry, u.primitives, u.first_primitive));
   }
+}
+
+void ReportCoarseSpacing(const CheckContext& ctx, const BuildActivity& activity, uint32_t permille) {
+  for (const BuildActivity::CoarseSpacing& c : activity.coarse_spacing()) {
+    const OpOrigin& origin = activity.origin();
+    ctx.reporter.Report(
+        Severity::kWarning, kFloatSpacingId, Location(OpCommandName(origin.command)),
+        {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, origin.command_buffer),
+         Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, activity.dst())},
+        fmt::format("{}: on execution, geometry {}: {} primitive(s) lie where 32-bit floats are spaced more than "
+                    "{}/1000 of their size apart (first: primitive {}, a coordinate of magnitude {:g}, where floats "
+                    "are {:g} apart, for a size of {:g}): positions and hits there are imprecise. Move the geometry "
+                    "nearer the origin (an instance transform can carry the offset) or raise "
+                    "capture_float_spacing_permille.",
+                    DescribeOrigin(origin), c.geometry, c.primitives, permille, c.first_primitive, c.magnitude,
+                    std::nextafter(c.magnitude, INFINITY) - c.magnitude, c.size));
+  }
+}
+
+void ReportDegenerateInstance(const CheckContext& ctx, const InstanceReferenceCheck& build, uint32_t geometry,
+                              uint32_t instance, VkAccelerationStructureKHR referenced, VkDeviceAddress address) {
+  ctx.reporter.Report(Severity::kInfo, kDegenerateInstanceId, Location(OpCommandName(build.build.command)),
+                      {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, build.build.command_buffer),
+                       Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, build.dst),
+                       Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, referenced)},
+                      fmt::format("{}: builds top-level {}; on execution, geometry {}, instance {} references "
+                                  "VkAccelerationStructureKHR {} (address 0x{:x}), whose last build has no active "
+                                  "primitive: the instance is degenerate (nothing in it can be hit).",
+                                  DescribeOrigin(build.build), Hex(build.dst), geometry, instance, Hex(referenced),
+                                  address));
 }
 
 void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "build_report.h"
+#include "capture_notices.h"
 #include "structure_memory.h"
 
 namespace asval {
@@ -220,8 +221,13 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
                    referenced.end());
   uint32_t findings = 0;
   for (const Referenced& r : referenced) {
-    findings += CheckReferenced(ctx, c, *log, info, r, live.structures[static_cast<std::size_t>(r.structure)]);
-    if (findings >= kMaxStructureFindings) break;
+    const auto k = static_cast<std::size_t>(r.structure);
+    const std::shared_ptr<const AccelerationStructureState>& structure = live.structures[k];
+    if (k < c.activities.size() && c.activities[k] && c.activities[k]->NoActivePrimitive()) {
+      ReportDegenerateInstance(ctx, c, r.geometry, r.instance, structure->handle, structure->device_address);
+    }
+    if (findings >= kMaxStructureFindings) continue;
+    findings += CheckReferenced(ctx, c, *log, info, r, structure);
   }
 }
 

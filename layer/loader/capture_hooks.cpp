@@ -16,15 +16,19 @@ namespace asval {
 void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   if (!data.capture_tracker || data.capture_tracker->idle()) return;
   const CheckContext ctx = MakeCheckContext(data);
+  const LayerSettings& settings = data.instance->settings;
+  const uint32_t warnings = settings.capture_warnings;
+  const uint32_t spacing_permille = warnings & kCaptureWarnFloatSpacing ? settings.capture_float_spacing_permille : 0;
   data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
     for (const std::shared_ptr<BuildActivity>& activity : done.fills) {
-      activity->Fill();
-      ReportUndefinedInput(ctx, *activity);
+      activity->Fill(spacing_permille);
+      ReportUndefinedInput(ctx, *activity, warnings);
+      if (spacing_permille != 0) ReportCoarseSpacing(ctx, *activity, spacing_permille);
     }
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
     for (const InstanceReferenceCheck& build : done.instance_checks) {
       CheckInstanceReferences(ctx, build);
-      ReportInstanceTransforms(ctx, build);
+      if (warnings & kCaptureWarnNonFiniteTransform) ReportInstanceTransforms(ctx, build);
     }
     for (const IndirectRangeCheck& build : done.indirect_checks) CheckIndirectRanges(ctx, build);
   });

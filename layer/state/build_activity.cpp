@@ -1,8 +1,10 @@
 #include "build_activity.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
+#include "asval/builder/build_input.h"
 #include "asval/builder/classify.h"
 
 namespace asval {
@@ -55,6 +57,62 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   return result.status == builder::ClassifyStatus::Ok && result.unreadable == 0 && !result.indexHashPartial;
 }
 
+// The builder's per-primitive boxes of one captured triangle or AABB geometry (exactly decoded, through the
+// geometry's transform when it was captured), into `out`; false for other geometries.
+bool PrimitiveBoxes(const CaptureLog& log, const CapturedGeometry& g, builder::BuildInput* out) {
+  if (g.range.primitiveCount == 0 || !g.data.present) return false;
+  constexpr bool kKeepDegenerate = true;  // kept, and skipped below by their zero size
+  if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    builder::TriangleGeometryView view;
+    view.vertexData = log.Bytes(g.data);
+    view.vertexDataBytes = g.data.size;
+    view.vertexFormat = g.vertex_format;
+    view.vertexStride = g.vertex_stride;
+    view.maxVertex = g.max_vertex;
+    view.indexType = g.index_type;
+    if (g.indices.present) {
+      view.indexData = log.Bytes(g.indices);
+      view.indexDataBytes = g.indices.size;
+    }
+    if (g.transform.present) {
+      view.transformData = log.Bytes(g.transform);
+      view.transformDataBytes = g.transform.size;
+    }
+    view.range = g.range;
+    builder::AppendTriangles(view, kKeepDegenerate, 0, out);
+    return true;
+  }
+  if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
+    builder::AabbGeometryView view;
+    view.data = log.Bytes(g.data);
+    view.dataBytes = g.data.size;
+    view.stride = g.aabb_stride;
+    view.range = g.range;
+    builder::AppendAabbs(view, kKeepDegenerate, 0, out);
+    return true;
+  }
+  return false;
+}
+
+// The distance from |x| to the next larger float: how finely positions near x can be placed.
+float SpacingAt(float x) {
+  const float a = std::fabs(x);
+  return std::nextafter(a, INFINITY) - a;
+}
+
+// Whether a primitive's box is so far out that float spacing there exceeds permille / 1000 of its size.
+bool CoarselySpaced(const builder::PrimRef& box, uint32_t permille, float* magnitude, float* size) {
+  float m = 0, extent = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    m = std::max({m, std::fabs(box.lo[axis]), std::fabs(box.hi[axis])});
+    extent = std::max(extent, box.hi[axis] - box.lo[axis]);
+  }
+  if (!std::isfinite(m) || !std::isfinite(extent) || extent <= 0) return false;  // not a size to compare with
+  *magnitude = m;
+  *size = extent;
+  return static_cast<double>(SpacingAt(m)) * 1000.0 > static_cast<double>(permille) * extent;
+}
+
 // The first NaN or infinite element of a geometry's captured transform, or -1 (none, or not captured).
 int NonFiniteElement(const CaptureLog& log, const CapturedGeometry& g) {
   return g.transform.present ? FirstNonFiniteElement(log.Bytes(g.transform)) : -1;
@@ -71,7 +129,15 @@ int FirstNonFiniteElement(const uint8_t* matrix) {
   return -1;
 }
 
-void BuildActivity::Fill() {
+bool BuildActivity::NoActivePrimitive() const {
+  if (status_ != Status::kReady) return false;
+  for (const builder::ActivityRecord& g : geometries_) {
+    if (g.activeCount != 0) return false;
+  }
+  return true;
+}
+
+void BuildActivity::Fill(uint32_t spacing_permille) {
   if (status_ != Status::kPending) return;
   const CaptureLog* log = log_.get();
   const CapturedInfo* readable = log ? log->Readable(info_) : nullptr;
@@ -98,8 +164,29 @@ void BuildActivity::Fill() {
       undefined_.push_back(UndefinedInput{j, result.undefinedNaN, result.firstUndefined, transform_element});
     }
   }
+  if (spacing_permille != 0) ScanSpacing(*log, info, spacing_permille);
   status_ = Status::kReady;
   log_.reset();
+}
+
+void BuildActivity::ScanSpacing(const CaptureLog& log, const CapturedInfo& info, uint32_t permille) {
+  thread_local builder::BuildInput boxes;  // reused: a steady stream of frames allocates nothing
+  for (uint32_t j = 0; j < info.geometry_count; ++j) {
+    boxes.refs.clear();
+    if (!PrimitiveBoxes(log, log.geometries[info.first_geometry + j], &boxes)) continue;
+    CoarseSpacing found;
+    found.geometry = j;
+    for (const builder::PrimRef& box : boxes.refs) {
+      float magnitude = 0, size = 0;
+      if (!CoarselySpaced(box, permille, &magnitude, &size)) continue;
+      if (found.primitives++ == 0) {
+        found.first_primitive = box.id;
+        found.magnitude = magnitude;
+        found.size = size;
+      }
+    }
+    if (found.primitives != 0) coarse_.push_back(found);
+  }
 }
 
 }  // namespace asval

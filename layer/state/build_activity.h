@@ -35,6 +35,16 @@ class BuildActivity {
     int transform_element = -1;    // triangles: the first NaN or infinite element of the transform (row * 4 + col)
   };
 
+  // Primitives whose coordinates are so large that 32-bit floats there are spaced more than a fraction of the
+  // primitive's size apart (a warning, not a rule): per geometry, counted, the first named.
+  struct CoarseSpacing {
+    uint32_t geometry = 0;
+    uint32_t primitives = 0;
+    uint32_t first_primitive = 0;
+    float magnitude = 0;  // the first one's largest coordinate
+    float size = 0;       // and its size (its box's largest extent)
+  };
+
   BuildActivity(std::shared_ptr<const CaptureLog> log, uint32_t info, const OpOrigin& origin,
                 VkAccelerationStructureKHR dst)
       : log_(std::move(log)), info_(info), origin_(origin), dst_(dst) {}
@@ -44,8 +54,9 @@ class BuildActivity {
   const std::vector<builder::ActivityRecord>& geometries() const { return geometries_; }
 
   // Classifies the captured bytes (the submission completed). Geometries the builder cannot classify (a format
-  // it does not decode, bytes not captured) leave the whole activity unknown.
-  void Fill();
+  // it does not decode, bytes not captured) leave the whole activity unknown. spacing_permille > 0 also scans the
+  // triangles and AABBs for coarse float spacing (coarse_spacing()): a second pass, so only when asked.
+  void Fill(uint32_t spacing_permille = 0);
   // The bytes cannot be trusted (the same capture written twice before it was read): unknown.
   void MarkUnknown() {
     status_ = Status::kUnknown;
@@ -56,13 +67,20 @@ class BuildActivity {
   VkAccelerationStructureKHR dst() const { return dst_; }
   // kReady: the geometries with undefined input (usually none).
   const std::vector<UndefinedInput>& undefined_input() const { return undefined_; }
+  // kReady, when Fill scanned for it: the geometries with coarsely spaced primitives (usually none).
+  const std::vector<CoarseSpacing>& coarse_spacing() const { return coarse_; }
+  // kReady: no geometry has an active primitive (an instance of it is degenerate).
+  bool NoActivePrimitive() const;
 
  private:
+  void ScanSpacing(const CaptureLog& log, const CapturedInfo& info, uint32_t permille);
+
   Status status_ = Status::kPending;
   std::shared_ptr<const CaptureLog> log_;  // until filled
   uint32_t info_ = 0;
   std::vector<builder::ActivityRecord> geometries_;
   std::vector<UndefinedInput> undefined_;
+  std::vector<CoarseSpacing> coarse_;
   OpOrigin origin_;
   VkAccelerationStructureKHR dst_ = VK_NULL_HANDLE;
 };
@@ -82,6 +100,10 @@ struct InstanceReferenceCheck {
   std::shared_ptr<const CaptureLog> log;  // its captured instances
   uint32_t info = 0;                      // in log->infos
   std::shared_ptr<const LiveStructureAddresses> live;
+  // When degenerate instances are reported (DeviceState::instance_activity_snapshots): per structure of `live`,
+  // the activity of the build that last executed on it as of this build's submission (null: not captured);
+  // else empty.
+  std::vector<std::shared_ptr<const BuildActivity>> activities;
   OpOrigin build;
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
 };

@@ -146,6 +146,14 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     check.log = log->shared_from_this();
     check.info = op.capture_info;
     check.live = state.live_structure_addresses.Get(state.acceleration_structures);
+    if (state.instance_activity_snapshots) {
+      check.activities.reserve(check.live->structures.size());
+      for (const auto& structure : check.live->structures) {
+        const AsHistory* h = store.Find(structure->handle);
+        const bool built = h && h->kind == HistoryKind::kBuilt && !h->clobbered;
+        check.activities.push_back(built ? h->activity : nullptr);
+      }
+    }
     check.build = op.origin;
     check.dst = op.dst;
     captures.instance_checks.push_back(std::move(check));
