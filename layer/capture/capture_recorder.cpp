@@ -5,90 +5,16 @@
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
+#include "capture_plan.h"
 #include "structure_memory.h"
 
 namespace asval {
 
 namespace {
 
-constexpr VkDeviceSize kNoBytes = std::numeric_limits<VkDeviceSize>::max();
-constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);  // 24
-constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
-constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);                 // 48
-
-VkDeviceSize Add(VkDeviceSize a, VkDeviceSize b) { return a > kNoBytes - b ? kNoBytes : a + b; }
-VkDeviceSize Mul(VkDeviceSize a, VkDeviceSize b) { return b != 0 && a > kNoBytes / b ? kNoBytes : a * b; }
-
-// One range to copy: from a device address into the capture log.
-struct Source {
-  VkDeviceAddress address;
-  VkDeviceSize size;
-  CapturedBytes* into;
-  bool optional = false;  // not needed for the rules (a transform, for the warnings): skipped when not copyable
-};
-
-// The ranges geometry g reads (exactly the bytes the specification says a build consumes, from where it starts
-// reading), with the captured geometry's parameters rewritten for bytes that start there. False when the
-// geometry is not captured.
-bool PlanGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerationStructureBuildRangeInfoKHR& r,
-                  CapturedGeometry* out, std::vector<Source>& sources) {
-  out->type = g.geometryType;
-  out->range.primitiveCount = r.primitiveCount;
-  const VkDeviceSize n = r.primitiveCount;
-  if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
-    const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
-    const VertexFormatInfo& format = VertexFormatFacts(t.vertexFormat);
-    const int index_bytes = builder::IndexTypeBytes(t.indexType);  // the builder's: it reads them
-    if (!format.decodable || index_bytes < 0) return false;
-    out->vertex_format = t.vertexFormat;
-    out->vertex_stride = t.vertexStride;
-    out->index_type = t.indexType;
-    if (n == 0) return true;
-    if (t.vertexData.deviceAddress == 0) return false;
-    if (t.transformData.deviceAddress != 0) {
-      sources.push_back(Source{Add(t.transformData.deviceAddress, r.transformOffset), kTransformBytes, &out->transform,
-                               true});
-    }
-    if (index_bytes == 0) {
-      // Vertex k of the range is read at primitiveOffset + stride * (firstVertex + k); the last one for its size.
-      const VkDeviceSize first = Add(r.primitiveOffset, Mul(t.vertexStride, r.firstVertex));
-      const VkDeviceSize bytes = Add(Mul(t.vertexStride, Mul(3, n) - 1), format.vertexBytes);
-      out->max_vertex = t.maxVertex >= r.firstVertex ? t.maxVertex - r.firstVertex : 0;
-      sources.push_back(Source{Add(t.vertexData.deviceAddress, first), bytes, &out->data});
-    } else {
-      if (t.indexData.deviceAddress == 0) return false;
-      // Indices from primitiveOffset; vertices index + firstVertex up to maxVertex, from vertexData.
-      out->max_vertex = t.maxVertex;
-      out->range.firstVertex = r.firstVertex;
-      sources.push_back(Source{Add(t.indexData.deviceAddress, r.primitiveOffset), Mul(Mul(3, n), index_bytes),
-                               &out->indices});
-      sources.push_back(
-          Source{t.vertexData.deviceAddress, Add(Mul(t.vertexStride, t.maxVertex), format.vertexBytes), &out->data});
-    }
-    return true;
-  }
-  if (g.geometryType == VK_GEOMETRY_TYPE_AABBS_KHR) {
-    const VkAccelerationStructureGeometryAabbsDataKHR& a = g.geometry.aabbs;
-    out->aabb_stride = a.stride;
-    if (n == 0) return true;
-    if (a.data.deviceAddress == 0) return false;
-    sources.push_back(
-        Source{Add(a.data.deviceAddress, r.primitiveOffset), Add(Mul(a.stride, n - 1), kAabbBytes), &out->data});
-    return true;
-  }
-  if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-    const VkAccelerationStructureGeometryInstancesDataKHR& in = g.geometry.instances;
-    // Arrays of pointers: the pointers only (their alignment is a rule); where they point is known on the device
-    // alone, so the records themselves, and with them the references and the activity, stay unknown.
-    out->array_of_pointers = in.arrayOfPointers == VK_TRUE;
-    if (n == 0) return true;
-    if (in.data.deviceAddress == 0) return false;
-    const VkDeviceSize record_bytes = out->array_of_pointers ? sizeof(VkDeviceAddress) : kInstanceBytes;
-    sources.push_back(Source{Add(in.data.deviceAddress, r.primitiveOffset), Mul(record_bytes, n), &out->data});
-    return true;
-  }
-  return false;
-}
+using Source = CaptureSource;
+constexpr auto Add = SaturatingAddBytes;
+constexpr auto Mul = SaturatingMulBytes;
 
 // The buffer a range can be copied from: bound, created copyable by the layer, holding the whole range.
 std::optional<AddressHit> CopyableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
@@ -238,7 +164,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     sources.clear();
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanGeometry(*g, info_ranges[j], &planned[j], sources);
+      entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources);
     }
     VkDeviceSize total = 0;
     for (const Source& s : sources) total = Add(total, s.size);

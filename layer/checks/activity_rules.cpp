@@ -31,7 +31,7 @@ std::string Named(const std::array<builder::ActivityChange, kNamed>& changes, st
   return text;
 }
 
-[[gnu::cold]] void Report(const CheckContext& ctx, const ActivityComparison& c, uint32_t geometry, const char* suffix,
+[[gnu::cold]] bool Report(const CheckContext& ctx, const ActivityComparison& c, uint32_t geometry, const char* suffix,
                           const std::string& what) {
   // The command, as the other findings at execution; the message names the info (DescribeOrigin) and geometry.
   const Location loc(OpCommandName(c.update.command));
@@ -39,7 +39,7 @@ std::string Named(const std::array<builder::ActivityChange, kNamed>& changes, st
       "{}: updates srcAccelerationStructure {} into {}; on execution, geometry {}: {}. The source's last executed "
       "build: {}.",
       DescribeOrigin(c.update), Hex(c.src), Hex(c.dst), geometry, what, DescribeOrigin(c.source_build));
-  ctx.reporter.Report(Severity::kError, Vuid(c, suffix), loc,
+  return ctx.reporter.Report(Severity::kError, Vuid(c, suffix), loc,
                       {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, c.update.command_buffer),
                        Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, c.src),
                        Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, c.dst == c.src ? VK_NULL_HANDLE : c.dst)},
@@ -48,12 +48,13 @@ std::string Named(const std::array<builder::ActivityChange, kNamed>& changes, st
 
 }  // namespace
 
-void CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& c) {
+bool CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& c) {
   if (!c.before || !c.after || c.before->status() != BuildActivity::Status::kReady ||
       c.after->status() != BuildActivity::Status::kReady) {
     ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
-    return;
+    return false;
   }
+  bool skip = false;
   ctx.state.capture_counters.updates_compared.fetch_add(1, std::memory_order_relaxed);
   const auto& before = c.before->geometries();
   const auto& after = c.after->geometries();
@@ -64,20 +65,22 @@ void CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& c) {
     const builder::ActivityDiff diff = builder::CompareActivity(before[j], after[j], changes.data(), changes.size());
     const uint32_t geometry = static_cast<uint32_t>(j);
     if (diff.becameActive != 0) {
-      Report(ctx, c, geometry, "pInfos-03663",
+      skip |= Report(ctx, c, geometry, "pInfos-03663",
              fmt::format("{} primitive(s) inactive in the source are active in the update: primitive {}",
                          diff.becameActive, Named(changes, diff.reported, true, diff.becameActive)));
     }
     if (diff.becameInactive != 0) {
-      Report(ctx, c, geometry, "pInfos-03664",
+      skip |= Report(ctx, c, geometry, "pInfos-03664",
              fmt::format("{} primitive(s) active in the source are inactive in the update (a NaN first vertex "
                          "component or AABB minX): primitive {}",
                          diff.becameInactive, Named(changes, diff.reported, false, diff.becameInactive)));
     }
     if (diff.indexHashDiffers) {
-      Report(ctx, c, geometry, "pInfos-03768", "the index values differ from those the source was last built with");
+      skip |= Report(ctx, c, geometry, "pInfos-03768",
+                     "the index values differ from those the source was last built with");
     }
   }
+  return skip;
 }
 
 }  // namespace asval

@@ -11,6 +11,7 @@ namespace asval {
 // Reports what `update` changed against the source's last build: inactive primitives made active (03663),
 // active ones made inactive (03664), index values changed (03768), naming the first few primitives. When either
 // activity is unknown (not captured, bytes not trusted) the rules are skipped and counted.
-void CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& update);
+// True when the app's callback asked to skip the call (host updates, judged before their downcall).
+bool CheckUpdateActivity(const CheckContext& ctx, const ActivityComparison& update);
 
 }  // namespace asval

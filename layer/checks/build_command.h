@@ -10,6 +10,8 @@
 
 namespace asval {
 
+class CaptureLog;
+
 enum class BuildCommandKind { kCmdBuild, kCmdBuildIndirect, kHostBuild };
 
 struct BuildCommand {
@@ -26,6 +28,9 @@ struct BuildCommand {
   const VkDeviceAddress* indirect_addresses = nullptr;
   const uint32_t* indirect_strides = nullptr;
   const uint32_t* const* max_primitive_counts = nullptr;
+  // Host builds: the inputs captured when called (host_capture.h), for the activity rules; null when none.
+  CaptureLog* host_capture = nullptr;
+  const uint32_t* host_captured = nullptr;  // per info: its index in host_capture->infos plus one, or 0
 
   bool is_host() const { return kind == BuildCommandKind::kHostBuild; }
   bool is_indirect() const { return kind == BuildCommandKind::kCmdBuildIndirect; }

@@ -2,30 +2,62 @@
 
 #include <fmt/format.h>
 
+#include <memory>
 #include <mutex>
+#include <vector>
 
+#include "activity_rules.h"
 #include "history_findings.h"
 #include "history_recorder.h"
 #include "update_rules.h"
 
 namespace asval {
 
+namespace {
+
+// A host update whose inputs were captured when it was called, paired with its source's activity as the history
+// holds it now (the host build runs now): compared outside the store's lock, since it reports.
+void CollectActivityComparison(const HistoryStore& store, const AsOp& op, std::vector<ActivityComparison>& out) {
+  if (!op.is_update() || !op.capture_log) return;
+  ActivityComparison comparison;
+  if (const AsHistory* src = store.Find(op.src)) {
+    comparison.before = src->activity;
+    if (src->build) comparison.source_build = src->build->origin;
+  }
+  comparison.after = std::make_shared<BuildActivity>(op.capture_log->shared_from_this(), op.capture_info, op.origin,
+                                                     op.dst);
+  comparison.update = op.origin;
+  comparison.src = op.src;
+  comparison.dst = op.dst;
+  out.push_back(std::move(comparison));
+}
+
+}  // namespace
+
 bool ValidateHostOps(const CheckContext& ctx, const OpBatch& batch, const char* function) {
   if (!ctx.state.history_tracked || batch.empty()) return false;
   HistoryFindings findings;
+  std::vector<ActivityComparison> activity;
   {
     std::unique_lock<std::mutex> lock = ctx.state.history.store.Lock();
     const HistoryCheckSite site{Location(function), VK_NULL_HANDLE, false};
     for (const AsOp& op : batch.ops()) {
       CheckOpHistory(ctx.state, ctx.state.history.store, ctx.enabled_checks, batch, op, site, findings);
+      if (ctx.Enabled(kCheckHistory)) CollectActivityComparison(ctx.state.history.store, op, activity);
     }
   }
-  return findings.ReportAll(ctx.reporter);  // no lock held: the app's callback may call Vulkan
+  bool skip = findings.ReportAll(ctx.reporter);  // no lock held: the app's callback may call Vulkan
+  for (ActivityComparison& update : activity) {
+    update.after->Fill();  // this call's own record, not shared yet
+    skip |= CheckUpdateActivity(ctx, update);
+  }
+  return skip;
 }
 
 bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.is_host() || !cmd.infos) return false;  // device builds: checked at submission
-  return ValidateHostOps(ctx, HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges), cmd.function);
+  return ValidateHostOps(
+      ctx, HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges, cmd.host_capture, cmd.host_captured), cmd.function);
 }
 
 void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device) {

@@ -5,6 +5,7 @@
 #include "capture_notices.h"
 #include "check_thread_data.h"
 #include "history_recorder.h"
+#include "host_capture.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
 
@@ -99,13 +100,25 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
   cmd.info_count = infoCount;
   cmd.infos = pInfos;
   cmd.ranges = ppBuildRangeInfos;
+  // The inputs of updatable builds and updates, copied now (host memory): the activity rules judge them, and the
+  // history keeps their activity.
+  HostCapture capture;
+  const LayerSettings& settings = data->instance->settings;
+  if (settings.capture != kCaptureOff && data->state.history_tracked) {
+    capture = CaptureHostBuildInputs(infoCount, pInfos, ppBuildRangeInfos, VkDeviceSize{settings.capture_budget_mb} << 20,
+                                     data->state.capture_counters);
+    cmd.host_capture = capture.log.get();
+    cmd.host_captured = capture.captured_or_null();
+  }
   // Skipped by the app's callback: the build did not happen. VK_ERROR_VALIDATION_FAILED_EXT is what the
   // Khronos layer returns in that case.
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return VK_ERROR_VALIDATION_FAILED_EXT;
   const VkResult result =
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
   // History: applied now on success, or when the deferred operation completes.
-  FinishHostOps(data->state, HostBuildOps(infoCount, pInfos, ppBuildRangeInfos), deferredOperation, result);
+  FinishHostOps(data->state,
+                HostBuildOps(infoCount, pInfos, ppBuildRangeInfos, capture.log.get(), capture.captured_or_null()),
+                deferredOperation, result, capture.log);
   return result;
 }
 

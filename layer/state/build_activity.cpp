@@ -130,7 +130,7 @@ int FirstNonFiniteElement(const uint8_t* matrix) {
 }
 
 bool BuildActivity::NoActivePrimitive() const {
-  if (status_ != Status::kReady) return false;
+  if (status() != Status::kReady) return false;
   for (const builder::ActivityRecord& g : geometries_) {
     if (g.activeCount != 0) return false;
   }
@@ -138,7 +138,7 @@ bool BuildActivity::NoActivePrimitive() const {
 }
 
 void BuildActivity::Fill(uint32_t spacing_permille) {
-  if (status_ != Status::kPending) return;
+  if (status_.load(std::memory_order_relaxed) != Status::kPending) return;
   const CaptureLog* log = log_.get();
   const CapturedInfo* readable = log ? log->Readable(info_) : nullptr;
   if (!readable) {
@@ -165,7 +165,7 @@ void BuildActivity::Fill(uint32_t spacing_permille) {
     }
   }
   if (spacing_permille != 0) ScanSpacing(*log, info, spacing_permille);
-  status_ = Status::kReady;
+  status_.store(Status::kReady, std::memory_order_release);
   log_.reset();
 }
 

@@ -7,6 +7,7 @@
 // Created pending when a submission is applied (submission order), filled when that submission completes
 // (CaptureTracker, layer/capture), in submission order, under the device's capture processing lock, which every
 // reader holds too.
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -49,7 +50,9 @@ class BuildActivity {
                 VkAccelerationStructureKHR dst)
       : log_(std::move(log)), info_(info), origin_(origin), dst_(dst) {}
 
-  Status status() const { return status_; }
+  // Acquire: a reader that sees kReady also sees the records Fill wrote (a host update compares its inputs with a
+  // source's activity outside the capture processing lock).
+  Status status() const { return status_.load(std::memory_order_acquire); }
   // kReady: one record per geometry of the build.
   const std::vector<builder::ActivityRecord>& geometries() const { return geometries_; }
 
@@ -59,7 +62,7 @@ class BuildActivity {
   void Fill(uint32_t spacing_permille = 0);
   // The bytes cannot be trusted (the same capture written twice before it was read): unknown.
   void MarkUnknown() {
-    status_ = Status::kUnknown;
+    status_.store(Status::kUnknown, std::memory_order_release);
     log_.reset();
   }
   // The build (or update) this is the activity of.
@@ -75,7 +78,7 @@ class BuildActivity {
  private:
   void ScanSpacing(const CaptureLog& log, const CapturedInfo& info, uint32_t permille);
 
-  Status status_ = Status::kPending;
+  std::atomic<Status> status_{Status::kPending};
   std::shared_ptr<const CaptureLog> log_;  // until filled
   uint32_t info_ = 0;
   std::vector<builder::ActivityRecord> geometries_;

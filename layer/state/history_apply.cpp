@@ -172,6 +172,14 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
   return node;
 }
 
+// A host build's activity: its inputs were copied when it was called and it has run, so the record is filled now,
+// before the history that holds it is published (under the store's lock: no reader sees it pending).
+std::shared_ptr<BuildActivity> HostActivity(const AsOp& op) {
+  auto node = std::make_shared<BuildActivity>(op.capture_log->shared_from_this(), op.capture_info, op.origin, op.dst);
+  node->Fill();
+  return node;
+}
+
 void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
                 Transaction* txn, SubmissionCaptures* captures) {
   std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
@@ -191,7 +199,11 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
     const AsHistory* old = store.Find(op.dst);
     h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);
   }
-  if (captures && op.capture_log) h.activity = CapturedActivity(state, store, op, *captures);
+  if (op.capture_log && op.origin.command == OpCommand::kHostBuild) {
+    h.activity = HostActivity(op);
+  } else if (captures && op.capture_log) {
+    h.activity = CapturedActivity(state, store, op, *captures);
+  }
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
 

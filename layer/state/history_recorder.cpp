@@ -181,9 +181,10 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
 // ---- host commands -------------------------------------------------------------------------------------------
 
 OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* capture,
+                     const uint32_t* captured) {
   OpBatch batch;
-  if (infos) batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges);
+  if (infos) batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges, capture, captured);
   return batch;
 }
 
@@ -227,16 +228,21 @@ OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR*
   return batch;
 }
 
-void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result) {
+void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result,
+                   std::shared_ptr<CaptureLog> capture) {
   if (!state.history_tracked || batch.empty()) return;
   if (result == VK_SUCCESS || result == VK_OPERATION_NOT_DEFERRED_KHR) {
     ApplyNow(state, batch);
   } else if (result == VK_OPERATION_DEFERRED_KHR && deferred) {
     auto pending = std::make_unique<DeferredHostOps>();
     pending->batch = std::move(batch);
+    if (capture) pending->captures.push_back(std::move(capture));
     std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
     auto [it, inserted] = state.history.deferred.try_emplace(deferred, std::move(pending));
-    if (!inserted) it->second->batch.AppendExecuted(pending->batch, VK_NULL_HANDLE);
+    if (!inserted) {
+      it->second->batch.AppendExecuted(pending->batch, VK_NULL_HANDLE);
+      for (auto& held : pending->captures) it->second->captures.push_back(std::move(held));
+    }
   }
   // Any other result: the command failed and changed nothing the layer can rely on.
 }

@@ -42,8 +42,11 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
                            const VkCommandBuffer* secondaries);
 
 // ---- host commands: their operations (pure: built before the checks run) ----
+// `capture`, `captured`: the inputs captured when the build was called (host_capture.h; null: none): each
+// captured info's operation carries its capture, whose activity is recorded when the operations are applied.
 OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges);
+                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* capture = nullptr,
+                     const uint32_t* captured = nullptr);
 OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info);
 OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info);
 OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info);
@@ -51,7 +54,9 @@ OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR*
 
 // After a host command's downcall: applies its operations when it completed successfully, keeps them for the
 // deferred operation when it was deferred, drops them when it failed.
-void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result);
+// `capture`: what the operations' captures point into (host builds), kept alive until they are applied.
+void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result,
+                   std::shared_ptr<CaptureLog> capture = nullptr);
 // Serialization sizes a successful vkWriteAccelerationStructuresPropertiesKHR wrote to pData.
 void RecordHostSerializationSizes(DeviceState& state, uint32_t count, const VkAccelerationStructureKHR* structures,
                                   const void* data, size_t stride);

@@ -7,7 +7,9 @@
 #include <memory>
 #include <mutex>
 #include <unordered_map>
+#include <vector>
 
+#include "capture_log.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
 #include "history.h"
@@ -22,6 +24,7 @@ struct QueryPoolState {
 // Host operations of one VkDeferredOperationKHR, applied when the operation is seen to complete successfully.
 struct DeferredHostOps {
   OpBatch batch;
+  std::vector<std::shared_ptr<CaptureLog>> captures;  // what the batch's captured builds point into
 };
 
 struct HistoryState {

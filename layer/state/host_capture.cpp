@@ -1,0 +1,86 @@
+#include "host_capture.h"
+
+#include <cstring>
+#include <new>
+
+#include "capture_plan.h"
+
+namespace asval {
+
+namespace {
+
+// Slabs on the heap: a host build's capture is read on the calling thread, at once or when its deferred operation
+// completes, never by the device.
+class HeapSlabOwner final : public CaptureSlabOwner {
+ public:
+  bool Take(VkDeviceSize bytes, CaptureSlab* slab) override {
+    auto* memory = new (std::nothrow) uint8_t[bytes];
+    if (!memory) return false;
+    slab->mapped = memory;
+    slab->size = bytes;
+    return true;
+  }
+  void Return(const CaptureSlab& slab) override { delete[] slab.mapped; }
+};
+
+bool Captured(const VkAccelerationStructureBuildGeometryInfoKHR& info) {
+  return info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
+         (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
+}
+
+}  // namespace
+
+HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                                   const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                                   VkDeviceSize budget_bytes, CaptureCounters& counters) {
+  HostCapture capture;
+  if (!infos || !ranges) return capture;
+  std::vector<CaptureSource> sources;
+  std::vector<CapturedGeometry> planned;
+  for (uint32_t i = 0; i < info_count; ++i) {
+    const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
+    if (!Captured(info)) continue;
+    if (!capture.log) {
+      capture.log = std::make_shared<CaptureLog>(std::make_shared<HeapSlabOwner>());
+      capture.captured.assign(info_count, 0);
+    }
+    CaptureLog& log = *capture.log;
+    CapturedInfo entry;
+    entry.geometry_count = info.geometryCount;
+    entry.element = i;
+    planned.assign(info.geometryCount, CapturedGeometry{});
+    sources.clear();
+    const bool readable = ranges[i] && (info.pGeometries || info.ppGeometries) &&
+                          (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) == 0;
+    entry.complete = readable;
+    for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
+      const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+      entry.complete = g && PlanCapturedGeometry(*g, ranges[i][j], true, &planned[j], sources);
+    }
+    VkDeviceSize total = 0;
+    for (const CaptureSource& s : sources) total = SaturatingAddBytes(total, s.size);
+    if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > budget_bytes) {
+      entry.complete = false;
+      counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
+    }
+    for (const CaptureSource& s : sources) {
+      if (!entry.complete) break;
+      if (!log.Reserve(s.size, s.into)) {
+        entry.complete = false;
+        break;
+      }
+      // The slab is this log's own heap memory (HeapSlabOwner), written here only, before anyone reads it.
+      std::memcpy(const_cast<uint8_t*>(log.Bytes(*s.into)), reinterpret_cast<const void*>(s.address), s.size);
+    }
+    if (entry.complete) {
+      counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
+      counters.bytes_captured.fetch_add(total, std::memory_order_relaxed);
+    } else {
+      counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+    }
+    capture.captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
+  }
+  return capture;
+}
+
+}  // namespace asval
