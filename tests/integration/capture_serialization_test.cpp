@@ -122,6 +122,19 @@ TEST_CASE("capture: a structure deserialized from device bytes the layer saw ser
   CHECK(f.monitor().Verify() == "");
 }
 
+// The behaviour before issue 12, kept with the capture off: the same flow as the test above, whose update is then
+// not judged. This is what the test above fails on without the capture of serialized bytes.
+TEST_CASE("capture off: a structure deserialized from device bytes has an unknown history (its invalid update is "
+          "not judged)",
+          "[integration][capture][history][passes-invalid-down]") {
+  HistoryFixture f("history", {{"capture", "off"}});
+  Rig rig(f, OneTriangle());
+  REQUIRE(rig.Run([&](VkCommandBuffer cb) { rig.Serialize(cb); }) == VK_SUCCESS);
+  REQUIRE(rig.Run([&](VkCommandBuffer cb) { rig.Deserialize(cb); }) == VK_SUCCESS);
+  CHECK(rig.Run([&](VkCommandBuffer cb) { rig.restored().Update(cb, TwoTriangles()); }) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
 TEST_CASE("capture: a structure deserialized from device bytes keeps the original's primitive activity "
           "(pInfos-03664 on its update)",
           "[integration][capture][history][passes-invalid-down]") {
