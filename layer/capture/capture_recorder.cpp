@@ -4,8 +4,8 @@
 #include <limits>
 
 #include "asval/builder/vertex_format.h"
-#include "history.h"
 #include "asval/vertex_formats.h"
+#include "history.h"
 #include "structure_memory.h"
 
 namespace asval {
