@@ -6,6 +6,7 @@
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
 #include "capture_plan.h"
+#include "history.h"
 #include "structure_memory.h"
 
 namespace asval {
@@ -194,6 +195,61 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
   }
   if (!copies.empty()) RecordCopies(ctx, cb, copies);
   return !captured.empty();
+}
+
+uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                               VkDeviceAddress address, VkAccelerationStructureKHR src) {
+  if (ctx.mode == kCaptureOff || address == 0 || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return 0;
+  // The header (two UUIDs, then the serialized size, the deserialized size and the handle count): less than it
+  // can never be hashed.
+  constexpr VkDeviceSize kHeaderBytes = 2 * VK_UUID_SIZE + 3 * sizeof(uint64_t);
+  // The copyable buffer holding `address` that reaches furthest past it. Inline hits: no allocation.
+  AddressHits hits;
+  ctx.state.buffer_addresses.FindContaining(address, hits);
+  std::optional<AddressHit> from;
+  VkDeviceSize capacity = 0;
+  for (const AddressHit& hit : hits) {
+    const VkDeviceSize remaining = hit.base + hit.size - address;
+    if (remaining <= capacity) continue;
+    std::optional<std::shared_ptr<const BufferState>> b = ctx.state.buffers.find(hit.buffer);
+    if (!b || !*b || !(*b)->bound || !(*b)->capture_source) continue;
+    from = hit;
+    capacity = remaining;
+  }
+  if (!from) {
+    ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
+    return 0;
+  }
+  VkDeviceSize wanted = capacity;
+  {
+    // The size the layer knows, read under the history's lock (serializations are rare next to builds).
+    const HistoryStore& store = ctx.state.history.store;
+    std::unique_lock<std::mutex> lock = store.Lock();
+    if (src != VK_NULL_HANDLE) {
+      const AsHistory* h = store.Find(src);
+      if (h && h->generation != 0 && h->serialization_size_generation == h->generation && h->serialization_size != 0) {
+        wanted = std::min<VkDeviceSize>(wanted, h->serialization_size);
+      }
+    } else if (const SerializedBlob* blob = store.FindDeviceBlobAt(address)) {
+      if (blob->span.end > blob->span.begin) wanted = std::min<VkDeviceSize>(wanted, blob->span.end - blob->span.begin);
+    }
+  }
+  CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
+  const VkDeviceSize budget_left = log.bytes_captured < ctx.budget_bytes ? ctx.budget_bytes - log.bytes_captured : 0;
+  const VkDeviceSize bytes = std::min(wanted, budget_left);
+  CapturedBytes into;
+  if (bytes < kHeaderBytes || !log.Reserve(bytes, &into)) {
+    ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
+    return 0;
+  }
+  // One copy: a single-element array of the thread's, as the builds' captures keep theirs (no allocation).
+  thread_local std::vector<Copy> copies;
+  copies.clear();
+  copies.push_back(Copy{from->buffer, log.BufferOf(into), VkBufferCopy{address - from->base, into.offset, bytes}});
+  RecordCopies(ctx, cb, copies);
+  ctx.counters.blobs_captured.fetch_add(1, std::memory_order_relaxed);
+  ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
+  return log.AddBlob(into);
 }
 
 }  // namespace asval

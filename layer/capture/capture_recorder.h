@@ -56,4 +56,18 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
                            const VkDeviceAddress* addresses, const uint32_t* strides,
                            const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured);
 
+// Device serialization (issue 12): the serialized bytes at `address` copied into the recording's capture log,
+// between the same two barriers as the builds' captures, so that a deserialization can be verified by content.
+// vkCmdCopyAccelerationStructureToMemoryKHR: called AFTER the app's serialization was recorded (the copy captures
+// what it wrote; the first barrier makes its write visible), with `src` the serialized structure.
+// vkCmdCopyMemoryToAccelerationStructureKHR: called BEFORE the app's deserialization (what it will read), with src
+// VK_NULL_HANDLE. How many bytes: the blob's size is in its header on the device, unknown here; the copy takes the
+// serialization size when the app read it back for src's current contents (else the size of the last blob the
+// layer saw serialized at `address`), at most what the copyable buffer holding `address` has left, and at most
+// what the recording's budget has left (a copy that turns out shorter than the header's size leaves the bytes
+// unknown, never guessed). Only buffers the capture may copy from (BufferState::capture_source: created with
+// TRANSFER_SRC). Returns the blob's index in recording.capture_log->blobs plus one; 0 when nothing was captured.
+uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                               VkDeviceAddress address, VkAccelerationStructureKHR src);
+
 }  // namespace asval

@@ -51,6 +51,8 @@ void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence
     {
       std::lock_guard<std::recursive_mutex> order(processing_);
       for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
+      // Serialized content never filled: the deserializations that read it stay unknown.
+      for (SerializeCapture& s : captures.serializes) s.content->status = SerializedContent::Status::kUnknown;
     }
     Unreserve(captures);
     return;

@@ -76,6 +76,20 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
                                 capture.bytes_captured.load(std::memory_order_relaxed),
                                 capture.updates_compared.load(std::memory_order_relaxed), not_captured));
   }
+  const uint64_t blobs = capture.blobs_captured.load(std::memory_order_relaxed);
+  const uint64_t blobs_missed = capture.blobs_not_captured.load(std::memory_order_relaxed);
+  if (blobs != 0 || blobs_missed != 0) {
+    reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
+                    {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+                    fmt::format("Execution-time capture of device serialization: serialized bytes captured {} times "
+                                "(serializations and deserializations), not captured {} times (a buffer created "
+                                "without TRANSFER_SRC, or over capture_budget_mb); {} "
+                                "deserializations of device bytes restored their history (the bytes read matched "
+                                "what was serialized there), {} left it unknown.",
+                                blobs, blobs_missed,
+                                capture.deserializations_restored.load(std::memory_order_relaxed),
+                                capture.deserializations_unverified.load(std::memory_order_relaxed)));
+  }
   if (skipped == 0) return;
   reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                   {Obj(VK_OBJECT_TYPE_DEVICE, device)},

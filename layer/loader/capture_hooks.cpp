@@ -1,7 +1,8 @@
 // Execution-time capture (issue 12): the waits through which the app learns that work completed. Each calls
 // down first; once the app's wait succeeded, the submissions with captures it covers are processed (their
-// captured builds' activity filled, the update rules judged on it), so that findings are reported before the
-// app's wait returns.
+// captured builds' activity filled, the update rules judged on it, device deserializations verified against
+// what was serialized), so that findings are reported before the app's wait returns, and a deserialized
+// structure's history is restored before the app can submit work that depends on the wait.
 #include <vector>
 
 #include "activity_rules.h"
@@ -9,6 +10,7 @@
 #include "indirect_rules.h"
 #include "instance_rules.h"
 #include "layer_data.h"
+#include "serialized_capture.h"
 #include "vk_intercepts.h"
 
 namespace asval {
@@ -31,6 +33,9 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
       if (warnings & kCaptureWarnNonFiniteTransform) ReportInstanceTransforms(ctx, build);
     }
     for (const IndirectRangeCheck& build : done.indirect_checks) CheckIndirectRanges(ctx, build);
+    // Device serialization: the content of the bytes serialized, and the deserializations verified against it
+    // (layer/state writes the history; it takes the store's lock itself, under the processing lock held here).
+    CompleteSerializedCaptures(data.state.history.store, data.state.capture_counters, done);
   });
 }
 

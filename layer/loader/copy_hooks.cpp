@@ -28,6 +28,15 @@ VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR
   return result;
 }
 
+// The capture of a device serialization's bytes (layer/capture): its index in the recording's capture log plus
+// one, or 0 (capture off, history not tracked, a command buffer the layer does not know, a null address).
+uint32_t CaptureBlob(DeviceData& data, VkCommandBuffer cb, VkDeviceAddress address, VkAccelerationStructureKHR src) {
+  if (!data.capture_tracker || !data.state.history_tracked || address == 0) return 0;
+  const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
+  if (!recording) return 0;  // a command buffer the layer never saw: its submission makes history unknown
+  return CaptureSerializedBlob(MakeCaptureContext(data), cb, *recording, address, src);
+}
+
 }  // namespace
 
 VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureKHR(VkCommandBuffer commandBuffer,
@@ -51,7 +60,10 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
     return;
   }
   data->dispatch.CmdCopyAccelerationStructureToMemoryKHR(commandBuffer, pInfo);
-  if (pInfo) RecordCmdCopyToMemory(data->state, commandBuffer, *pInfo);
+  // Post-record of the capture: the bytes just serialized, copied once the serialization executed (layer/capture),
+  // so that a deserialization of them can be verified by content.
+  const uint32_t captured = pInfo ? CaptureBlob(*data, commandBuffer, pInfo->dst.deviceAddress, pInfo->src) : 0;
+  if (pInfo) RecordCmdCopyToMemory(data->state, commandBuffer, *pInfo, captured);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
@@ -62,8 +74,10 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
       ValidateCopyMemoryToInfo(ctx, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, *pInfo)) {
     return;
   }
+  // Pre-record of the capture: the bytes the deserialization will read, copied just before it executes.
+  const uint32_t captured = pInfo ? CaptureBlob(*data, commandBuffer, pInfo->src.deviceAddress, VK_NULL_HANDLE) : 0;
   data->dispatch.CmdCopyMemoryToAccelerationStructureKHR(commandBuffer, pInfo);
-  if (pInfo) RecordCmdCopyMemoryTo(data->state, commandBuffer, *pInfo);
+  if (pInfo) RecordCmdCopyMemoryTo(data->state, commandBuffer, *pInfo, captured);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(

@@ -127,17 +127,55 @@ struct IndirectRangeCheck {
   std::shared_ptr<const BuildSnapshot> source;
 };
 
+// The content of the bytes a device serialization wrote (issue 12): the size its header gives and the hash of
+// exactly that many bytes, from the bytes captured after the serialization executed. Created pending when the
+// serialization is applied (submission order) and shared by the blob in the history store and the deserializations
+// applied after it; filled (or made unknown) when the serialization's submission completes, under the device's
+// capture processing lock, which every reader holds too.
+struct SerializedContent {
+  enum class Status : uint8_t { kPending, kReady, kUnknown };
+  Status status = Status::kPending;
+  uint64_t size = 0;
+  uint64_t hash = 0;
+};
+
+// A device serialization whose written bytes were captured (log->blobs[blob]): its content, filled at completion.
+struct SerializeCapture {
+  std::shared_ptr<const CaptureLog> log;
+  uint32_t blob = 0;
+  std::shared_ptr<SerializedContent> content;
+  bool read_twice = false;  // the same capture read twice by one submission: unknown
+};
+
+// A device deserialization whose read bytes were captured (log->blobs[blob]), from where the layer saw a
+// serialization (still valid when the deserialization was applied): dst gets the serialized structure's history
+// back only when the bytes it read hash to that serialization's content, and dst's contents did not change since.
+struct DeserializeCheck {
+  std::shared_ptr<const CaptureLog> log;
+  uint32_t blob = 0;
+  std::shared_ptr<const SerializedContent> expected;
+  std::shared_ptr<const BuildSnapshot> build;  // the serialized structure's last build, as the blob holds it
+  std::shared_ptr<BuildActivity> activity;     // ... and its activity (null when not captured)
+  VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+  uint64_t generation = 0;  // dst's contents generation that the deserialization gave it
+  bool read_twice = false;  // the same capture read twice by one submission: unknown
+};
+
 // What one submission's captures ask for once it completes, in submission order.
 struct SubmissionCaptures {
   std::vector<std::shared_ptr<BuildActivity>> fills;
   std::vector<ActivityComparison> comparisons;
   std::vector<InstanceReferenceCheck> instance_checks;
   std::vector<IndirectRangeCheck> indirect_checks;
+  // Serializations and deserializations of device bytes (filled and judged in that order: a deserialization in
+  // the same submission as the serialization it reads comes after it).
+  std::vector<SerializeCapture> serializes;
+  std::vector<DeserializeCheck> deserializes;
   // The recordings whose captures this submission reads (each counted once as pending: CaptureLog::SubmissionStarted).
   std::vector<std::shared_ptr<CaptureLog>> logs;
   // Each capture read once per submission (history_apply.cpp).
   std::map<std::pair<const CaptureLog*, uint32_t>, BuildActivity*> claimed;
-  bool empty() const { return fills.empty(); }
+  bool empty() const { return fills.empty() && serializes.empty() && deserializes.empty(); }
 };
 
 }  // namespace asval

@@ -29,6 +29,15 @@ struct CaptureCounters {
   std::atomic<uint64_t> infos_not_captured{0};
   // Updates whose activity rules (03663/03664/03768) were judged on captured bytes.
   std::atomic<uint64_t> updates_compared{0};
+  // Device serialization bytes (vkCmdCopyAccelerationStructureToMemoryKHR's written, vkCmdCopyMemoryTo...'s read):
+  // captured, and not captured (no copyable buffer, no slab, no room in the budget for the header).
+  std::atomic<uint64_t> blobs_captured{0};
+  std::atomic<uint64_t> blobs_not_captured{0};
+  // Deserializations of device bytes whose history was restored once their captured bytes matched what the layer
+  // saw serialized there; and those left unknown (bytes not captured in full, changed, or the destination
+  // changed before the completion was processed).
+  std::atomic<uint64_t> deserializations_restored{0};
+  std::atomic<uint64_t> deserializations_unverified{0};
   // Infos not captured because the recording's captures would have exceeded capture_budget_mb (included in
   // infos_not_captured), and whether that was reported (once per device).
   std::atomic<uint64_t> infos_over_budget{0};
@@ -131,6 +140,14 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   // Appends the destinations of the command being recorded; returns the index of the first (for
   // CapturedInfo::first_destination).
   uint32_t AddDestinations(const CommandDestination* command_destinations, uint32_t count);
+  // Appends the captured bytes of one device serialization's blob (from its start; `bytes.size` of them, which
+  // may be less than the blob when the budget or the buffer ended first); they count against the budget.
+  // Returns its index in `blobs` plus one.
+  uint32_t AddBlob(const CapturedBytes& bytes) {
+    bytes_captured += bytes.size;
+    blobs.push_back(bytes);
+    return static_cast<uint32_t>(blobs.size());
+  }
 
   // ---- under the capture processing lock (CaptureTracker) ----
   // A submission that reads this recording's captures is about to be made / was processed or not made. A second
@@ -149,6 +166,10 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   const CapturedInfo* Readable(uint32_t info) const {
     return !overlapped_ && info < infos.size() && infos[info].complete ? &infos[info] : nullptr;
   }
+  // blobs[blob] when its bytes can be read as the device wrote them (as Readable).
+  const CapturedBytes* ReadableBlob(uint32_t blob) const {
+    return !overlapped_ && blob < blobs.size() && blobs[blob].present ? &blobs[blob] : nullptr;
+  }
 
   std::vector<CaptureSlab> slabs;
   VkDeviceSize bytes_captured = 0;
@@ -156,6 +177,9 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   std::vector<CapturedGeometry> geometries;
   std::vector<uint32_t> max_primitive_counts;  // parallel to geometries (indirect infos only; else 0)
   std::vector<CommandDestination> destinations;
+  // Serialized bytes copied from device memory (a serialization's blob after it executed, a deserialization's
+  // before it executed); AsOp::capture_info of a kSerialize / kDeserialize operation indexes this.
+  std::vector<CapturedBytes> blobs;
 
  private:
   std::shared_ptr<CaptureSlabOwner> owner_;

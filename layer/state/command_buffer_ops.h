@@ -140,7 +140,8 @@ struct AsOp {
   uint32_t first_geometry = 0;  // index into the batch's geometries
   // The bytes this build read, captured when it executes (issue 12): capture_info is its index in
   // capture_log->infos; capture_log is null when the build was not captured. The log is kept alive by the
-  // published recording that holds this operation (RecordedOps::capture_logs).
+  // published recording that holds this operation (RecordedOps::capture_logs). kSerialize / kDeserialize of
+  // device memory: the serialized bytes written / read, capture_info indexing capture_log->blobs.
   CaptureLog* capture_log = nullptr;
   uint32_t capture_info = 0;
 

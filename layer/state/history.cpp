@@ -14,7 +14,8 @@ const char* UnknownReasonText(UnknownReason reason) {
       return "deserialized from bytes the layer did not see serialized (or saw modified since)";
     case UnknownReason::kCopiedFromUnknown: return "copied from a structure whose history is unknown";
     case UnknownReason::kDeserializedDeviceBytes:
-      return "deserialized from device memory, whose bytes the layer cannot verify";
+      return "deserialized from device memory whose bytes the layer could not verify (not captured, changed since "
+             "they were serialized, or not yet seen complete)";
     case UnknownReason::kLostOperations:
       return "written by a command buffer the layer did not see recorded, or whose operations it could not record";
     case UnknownReason::kUnreadableBuild: return "built by an invalid build whose geometries could not be read";
@@ -109,6 +110,22 @@ const SerializedBlob* HistoryStore::FindHostBlob(const void* host_address) const
   if (!host_address) return nullptr;
   for (auto it = blobs_.rbegin(); it != blobs_.rend(); ++it) {
     if (it->valid && it->host_address == host_address) return &*it;
+  }
+  return nullptr;
+}
+
+const SerializedBlob* HistoryStore::FindDeviceBlob(const MemorySpan& span) const {
+  if (span.memory == VK_NULL_HANDLE) return nullptr;
+  for (auto it = blobs_.rbegin(); it != blobs_.rend(); ++it) {
+    if (it->valid && it->span.memory == span.memory && it->span.begin == span.begin) return &*it;
+  }
+  return nullptr;
+}
+
+const SerializedBlob* HistoryStore::FindDeviceBlobAt(VkDeviceAddress address) const {
+  if (address == 0) return nullptr;
+  for (auto it = blobs_.rbegin(); it != blobs_.rend(); ++it) {
+    if (it->valid && it->device_address == address) return &*it;
   }
   return nullptr;
 }

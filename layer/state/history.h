@@ -47,7 +47,7 @@ enum class HistoryKind : uint8_t { kNeverBuilt, kBuilt, kUnknown };
 enum class UnknownReason : uint8_t {
   kNone,
   kDeserializedUnknownBytes,  // the bytes were not serialized by a command the layer saw, or were modified since
-  kDeserializedDeviceBytes,   // deserialized from device memory, whose bytes the layer cannot verify (yet)
+  kDeserializedDeviceBytes,   // deserialized from device memory whose bytes the layer has not verified (or cannot)
   kCopiedFromUnknown,         // cloned, compacted or deserialized from a structure whose history is unknown
   kLostOperations,            // the layer could not record an operation (allocation failure) or a command buffer
   kUnreadableBuild,           // built by an invalid build whose geometries could not be read
@@ -87,8 +87,13 @@ struct SerializedBlob {
   const void* host_address = nullptr;
   uint64_t host_size = 0;
   uint64_t host_hash = 0;
-  AsHistory history;  // the source's record at serialization (kind, build snapshot)
+  AsHistory history;  // the source's record at serialization (kind, build snapshot, activity)
   bool valid = true;  // false once a tracked write overlapped the bytes
+  // Device memory whose written bytes the capture copied (issue 12): where they start, and their content (size
+  // and hash), filled when the serialization's submission completes. Null when not captured: a deserialization
+  // from there then stays unknown.
+  VkDeviceAddress device_address = 0;
+  std::shared_ptr<SerializedContent> content;
 };
 
 // Query pool slots written by vkCmdWriteAccelerationStructuresPropertiesKHR: which structure (and contents
@@ -145,6 +150,11 @@ class HistoryStore {
   // Serialized bytes.
   uint64_t AddBlob(SerializedBlob blob, Transaction* txn);
   const SerializedBlob* FindHostBlob(const void* host_address) const;
+  // The latest valid blob of device memory that starts at span.begin of span.memory; null when none.
+  const SerializedBlob* FindDeviceBlob(const MemorySpan& span) const;
+  // The latest valid blob of device memory written at a device address; null when none (a hint only: the
+  // address may have been rebound since).
+  const SerializedBlob* FindDeviceBlobAt(VkDeviceAddress address) const;
   void InvalidateBlobsOverlapping(const MemorySpan& span, Transaction* txn);
   void InvalidateHostBlob(const void* host_address, Transaction* txn);
   void InvalidateAllBlobs(Transaction* txn);

@@ -224,12 +224,32 @@ void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Tr
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
 
-void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn) {
+// Whether one submission already reads capture (log, blob) of a serialization or deserialization: the device then
+// writes its bytes twice before the layer reads them (a secondary executed twice, a command buffer submitted twice
+// in one call), so that both readers are unknown. Submissions serialize rarely: a scan.
+bool ClaimBlob(SubmissionCaptures& captures, CaptureLog* log, uint32_t blob) {
+  bool first = true;
+  for (SerializeCapture& s : captures.serializes) {
+    if (s.log.get() == log && s.blob == blob) s.read_twice = true, first = false;
+  }
+  for (DeserializeCheck& d : captures.deserializes) {
+    if (d.log.get() == log && d.blob == blob) d.read_twice = true, first = false;
+  }
+  bool known_log = false;
+  for (const std::shared_ptr<CaptureLog>& held : captures.logs) known_log |= held.get() == log;
+  if (!known_log) captures.logs.push_back(log->shared_from_this());
+  return first;
+}
+
+void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn, SubmissionCaptures* captures) {
   const AsHistory src = store.Get(op.src);
   SerializedBlob blob;
   blob.history.kind = src.kind;
   blob.history.unknown_reason = src.unknown_reason;
   blob.history.build = src.build;
+  // The serialized structure's primitive activity travels with its bytes as with a clone: a deserialization
+  // recreates the structure exactly.
+  blob.history.activity = src.activity;
   if (op.memory.host_address) {
     store.InvalidateHostBlob(op.memory.host_address, txn);
     blob.host_address = op.memory.host_address;
@@ -252,18 +272,32 @@ void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn) {
   } else {
     store.InvalidateBlobsOverlapping(blob.span, txn);
   }
+  // Captured after it executed (issue 12): the content is hashed when this submission completes, and a later
+  // deserialization from here is verified against it.
+  blob.device_address = op.memory.device_address;
+  if (captures && op.capture_log) {
+    blob.content = std::make_shared<SerializedContent>();
+    SerializeCapture capture;
+    capture.log = op.capture_log->shared_from_this();
+    capture.blob = op.capture_info;
+    capture.content = blob.content;
+    capture.read_twice = !ClaimBlob(*captures, op.capture_log, op.capture_info);
+    captures->serializes.push_back(std::move(capture));
+  }
   store.AddBlob(std::move(blob), txn);
 }
 
-void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
+void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn,
+                      SubmissionCaptures* captures) {
   std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
   AsHistory& h = *fresh;
   const SerializedBlob* blob = nullptr;
-  // Only host bytes can be trusted to be what the layer saw serialized, by their hash: device memory may have
-  // been rewritten by commands the layer does not follow (vkCmdCopyBuffer, vkCmdUpdateBuffer, vkCmdFillBuffer,
-  // copies from images, shader writes), by the host through a mapping, or freed and reallocated.
-  // TODO(capture issue): verify device bytes by content when they are captured at execution time.
+  // Host bytes are trusted to be what the layer saw serialized by their hash, now. Device memory may have been
+  // rewritten by commands the layer does not follow (vkCmdCopyBuffer, vkCmdUpdateBuffer, vkCmdFillBuffer, copies
+  // from images, shader writes), by the host through a mapping, or freed and reallocated: its bytes are verified
+  // by content when the capture copied them, once this submission completes (DeserializeCheck); until then the
+  // history is unknown, so that an update submitted before the completion is processed is skipped, never guessed.
   if (op.memory.host_address) {
     const SerializedBlob* candidate = store.FindHostBlob(op.memory.host_address);
     if (candidate && SerializedHostSize(op.memory.host_address) == candidate->host_size &&
@@ -274,11 +308,31 @@ void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp&
   if (blob && blob->history.kind == HistoryKind::kBuilt) {
     h.kind = HistoryKind::kBuilt;
     h.build = blob->history.build;
+    h.activity = blob->history.activity;
   } else {
     h.kind = HistoryKind::kUnknown;
     h.unknown_reason = blob                  ? UnknownReason::kCopiedFromUnknown
                        : op.memory.host_address ? UnknownReason::kDeserializedUnknownBytes
                                                 : UnknownReason::kDeserializedDeviceBytes;
+  }
+  if (!op.memory.host_address && captures && op.capture_log) {
+    // The serialization the bytes should hold: the latest one there that no tracked write overlapped since, in
+    // submission order (what executes before this deserialization). Only a built structure's history is worth
+    // restoring.
+    const SerializedBlob* device_blob = store.FindDeviceBlob(op.memory.span);
+    const bool claimed_first = ClaimBlob(*captures, op.capture_log, op.capture_info);
+    if (device_blob && device_blob->content && device_blob->history.kind == HistoryKind::kBuilt) {
+      DeserializeCheck check;
+      check.log = op.capture_log->shared_from_this();
+      check.blob = op.capture_info;
+      check.expected = device_blob->content;
+      check.build = device_blob->history.build;
+      check.activity = device_blob->history.activity;
+      check.dst = op.dst;
+      check.generation = h.generation;
+      check.read_twice = !claimed_first;
+      captures->deserializes.push_back(std::move(check));
+    }
   }
   SetWritten(store, op.dst, std::move(h), op, txn);
 }
@@ -317,8 +371,8 @@ void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch
   switch (op.kind) {
     case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
     case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;
-    case OpKind::kSerialize: ApplySerialize(store, op, txn); break;
-    case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn); break;
+    case OpKind::kSerialize: ApplySerialize(store, op, txn, captures); break;
+    case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn, captures); break;
     case OpKind::kWriteProperties: ApplyWriteProperties(store, op, txn); break;
   }
 }
@@ -330,6 +384,24 @@ void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as,
   h.serialization_size = size;
   h.serialization_size_generation = generation;
   store.Set(as, std::move(h), nullptr);
+}
+
+bool RestoreDeserializedHistory(HistoryStore& store, const DeserializeCheck& check) {
+  const AsHistory* current = store.Find(check.dst);
+  // Only the record the deserialization left: a later build, copy or deserialization of dst (or its destruction)
+  // changed the generation; a later write over its memory set `clobbered` without changing it, and may still be
+  // undone by a submission in flight on another thread, whose undo would then leave this record alone.
+  if (!current || current->generation != check.generation || current->kind != HistoryKind::kUnknown ||
+      current->unknown_reason != UnknownReason::kDeserializedDeviceBytes || current->clobbered || !check.build) {
+    return false;
+  }
+  AsHistory h = *current;  // same contents, same generation (a serialization size read back stays attached)
+  h.kind = HistoryKind::kBuilt;
+  h.unknown_reason = UnknownReason::kNone;
+  h.build = check.build;
+  h.activity = check.activity;
+  store.Set(check.dst, std::move(h), nullptr);
+  return true;
 }
 
 uint64_t SerializedHostSize(const void* data) {

@@ -28,6 +28,13 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
 // fetched with vkGetQueryPoolResults) for the structure's current contents.
 void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size);
 
+// A device deserialization's captured bytes matched the content of the serialization it read (DeserializeCheck,
+// judged when its submission completed): dst gets the serialized structure's history back (last build and
+// activity), unless its record changed since the deserialization was applied (another operation on it, or a write
+// over its memory). True when restored. Called with the store's lock held, outside any submission's transaction:
+// the restore is not undone.
+bool RestoreDeserializedHistory(HistoryStore& store, const DeserializeCheck& check);
+
 // Where serialized bytes end: the header's total size (bytes 32..39, VK_UUID_SIZE * 2 in) of host data.
 uint64_t SerializedHostSize(const void* data);
 

@@ -85,6 +85,14 @@ AsOp CopyKindOp(OpKind kind, VkAccelerationStructureKHR src, VkAccelerationStruc
   return op;
 }
 
+// A serialization's or deserialization's captured bytes (index plus one in the recording's capture log, 0: none).
+// The log lives as long as the published recording that holds the operation (RecordedOps::capture_logs).
+void AttachBlobCapture(CommandBufferState& recording, uint32_t captured, AsOp& op) {
+  if (captured == 0 || !recording.capture_log) return;
+  op.capture_log = recording.capture_log.get();
+  op.capture_info = captured - 1;
+}
+
 void ApplyNow(DeviceState& state, const OpBatch& batch) {
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
   for (const AsOp& op : batch.ops()) ApplyOp(state, state.history.store, batch, op, nullptr);
@@ -115,22 +123,24 @@ void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerat
 }
 
 void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
-                           const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
+                           const VkCopyAccelerationStructureToMemoryInfoKHR& info, uint32_t captured) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyToMemory, cb);
   op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);
+  AttachBlobCapture(*recording, captured, op);
   Guarded(*recording, [&] { recording->recording.Append(op); });
 }
 
 void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
-                           const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
+                           const VkCopyMemoryToAccelerationStructureInfoKHR& info, uint32_t captured) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyMemoryTo, cb);
   op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);
+  AttachBlobCapture(*recording, captured, op);
   Guarded(*recording, [&] { recording->recording.Append(op); });
 }
 

@@ -30,10 +30,12 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, LastRecordedBuild* last = nullptr,
                     const uint32_t* captured = nullptr);
 void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerationStructureInfoKHR& info);
+// captured: the serialized bytes' index in the command buffer's capture log plus one (0: not captured), from the
+// capture's post-record (serialization) or pre-record (deserialization).
 void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
-                           const VkCopyAccelerationStructureToMemoryInfoKHR& info);
+                           const VkCopyAccelerationStructureToMemoryInfoKHR& info, uint32_t captured = 0);
 void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
-                           const VkCopyMemoryToAccelerationStructureInfoKHR& info);
+                           const VkCopyMemoryToAccelerationStructureInfoKHR& info, uint32_t captured = 0);
 void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
                               const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
                               uint32_t first_query);

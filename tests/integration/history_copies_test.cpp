@@ -1,6 +1,7 @@
 // History through copies, serialization and property queries: clone and compaction carry the source's
-// history; deserialization of device bytes leaves it unknown until the layer can verify them by content (host
-// bytes are verified by hash: tests/unit/history_unit_test.cpp), the skip counted and summarized at
+// history; deserialization of device bytes leaves it unknown unless the execution-time capture verifies them by
+// content once the deserialization completed (capture_serialization_test.cpp; host bytes are verified by hash:
+// tests/unit/history_unit_test.cpp), the skip counted and summarized at
 // vkDestroyDevice; src-04963, src-04959, src-03411, pAccelerationStructures-04964,
 // accelerationStructures-03431 and dst-03561 are checked when the command executes.
 #include <unistd.h>
@@ -260,7 +261,8 @@ Serialized BuildAndSerialize(vkkit::Device& device, Blas& blas, const Shape& sha
 // Regression (false positive found by an independent corpus): the layer used to restore the history of device
 // bytes it had seen serialized even after vkCmdCopyBuffer overwrote them with another structure's, and then
 // reported pInfos-03758 on this valid update. Device bytes can be rewritten by commands the layer does not
-// follow: until it verifies them by content, what they restore is unknown (skipped, counted).
+// follow: only bytes verified by content (the capture's hash of what was serialized there, compared with what the
+// deserialization read) restore a history; these differ, so it stays unknown (skipped, counted).
 TEST_CASE("history valid twin: deserializing device bytes overwritten by vkCmdCopyBuffer is not taken for what "
           "was serialized there",
           "[integration][history]") {
