@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "build_report.h"
 
@@ -47,7 +49,7 @@ void ReportCoarseSpacing(const CheckContext& ctx, const BuildActivity& activity,
                     "nearer the origin (an instance transform can carry the offset) or raise "
                     "capture_float_spacing_permille.",
                     DescribeOrigin(origin), c.geometry, c.primitives, permille, c.first_primitive, c.magnitude,
-                    std::nextafter(c.magnitude, INFINITY) - c.magnitude, c.size));
+                    FloatSpacingAt(c.magnitude), c.size));
   }
 }
 
@@ -64,15 +66,72 @@ void ReportDegenerateInstance(const CheckContext& ctx, const InstanceReferenceCh
                                   address));
 }
 
-void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build) {
+namespace {
+
+// Instances placed so far out that floats there are spaced more than permille / 1000 of the smallest primitive of
+// the structure they reference (its activity as of the build's submission: capture = all). Returns the count and
+// names the first.
+struct FarInstances {
+  uint32_t count = 0;
+  uint32_t first = 0;
+  float translation = 0;
+  float smallest = 0;
+};
+
+FarInstances FindFarInstances(const InstanceReferenceCheck& build, const uint8_t* records, uint32_t count,
+                              uint32_t permille) {
+  FarInstances far;
+  if (!build.live || build.activities.empty()) return far;
+  for (uint32_t k = 0; k < count; ++k) {
+    VkAccelerationStructureInstanceKHR instance;
+    std::memcpy(&instance, records + k * sizeof(instance), sizeof(instance));
+    const std::ptrdiff_t structure = build.live->Find(instance.accelerationStructureReference);
+    if (structure < 0) continue;
+    const std::shared_ptr<const BuildActivity>& activity = build.activities[static_cast<std::size_t>(structure)];
+    if (!activity || activity->status() != BuildActivity::Status::kReady || activity->smallest_primitive() <= 0) {
+      continue;
+    }
+    const float (&m)[3][4] = instance.transform.matrix;
+    const float translation = std::max({std::fabs(m[0][3]), std::fabs(m[1][3]), std::fabs(m[2][3])});
+    if (!std::isfinite(translation) || !SpacingExceeds(translation, activity->smallest_primitive(), permille)) continue;
+    if (far.count++ == 0) {
+      far.first = k;
+      far.translation = translation;
+      far.smallest = activity->smallest_primitive();
+    }
+  }
+  return far;
+}
+
+}  // namespace
+
+void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build, uint32_t warnings,
+                              uint32_t spacing_permille) {
   const CaptureLog* log = build.log.get();
   const CapturedInfo* readable = log ? log->Readable(build.info) : nullptr;
   if (!readable) return;
   const CapturedInfo& info = *readable;
+  const Location loc(OpCommandName(build.build.command));
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present || g.array_of_pointers) continue;
     const uint8_t* bytes = log->Bytes(g.data);
+    if (spacing_permille != 0) {
+      const FarInstances far = FindFarInstances(build, bytes, g.range.primitiveCount, spacing_permille);
+      if (far.count != 0) {
+        ctx.reporter.Report(
+            Severity::kWarning, kFloatSpacingId, loc,
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, build.build.command_buffer),
+             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, build.dst)},
+            fmt::format("{}: on execution, geometry {}: {} instance(s) are translated so far that 32-bit floats there "
+                        "are spaced more than {}/1000 of the smallest primitive of the structure they reference apart "
+                        "(first: instance {}, a translation of magnitude {:g}, where floats are {:g} apart, for a "
+                        "smallest primitive of {:g}): hits there are imprecise.",
+                        DescribeOrigin(build.build), j, far.count, spacing_permille, far.first, far.translation,
+                        FloatSpacingAt(far.translation), far.smallest));
+      }
+    }
+    if (!(warnings & kCaptureWarnNonFiniteTransform)) continue;
     uint32_t count = 0, first = 0;
     int element = -1;
     for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
@@ -81,7 +140,7 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
       if (e >= 0 && count++ == 0) first = k, element = e;
     }
     if (count == 0) continue;
-    ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, Location(OpCommandName(build.build.command)),
+    ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, loc,
                         {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, build.build.command_buffer),
                          Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, build.dst)},
                         fmt::format("{}: on execution, geometry {}: {} instance(s) have a NaN or infinite element in "

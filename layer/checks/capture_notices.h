@@ -34,7 +34,11 @@ void ReportCoarseSpacing(const CheckContext& ctx, const BuildActivity& activity,
 void ReportDegenerateInstance(const CheckContext& ctx, const InstanceReferenceCheck& build, uint32_t geometry,
                               uint32_t instance, VkAccelerationStructureKHR referenced, VkDeviceAddress address);
 // After a captured top-level build completed: its instances' transforms.
-void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build);
+// `warnings`: kCaptureWarnNonFiniteTransform reports non-finite instance transforms; spacing_permille > 0 (the
+// float_spacing warning) reports instances translated where floats are coarse for what they reference (needs the
+// referenced structures' activity: InstanceReferenceCheck::activities, capture = all).
+void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCheck& build, uint32_t warnings,
+                              uint32_t spacing_permille);
 // After a build's pre-record: reports the budget once, the first time it was exceeded on this device.
 void ReportCaptureBudget(const CheckContext& ctx, uint32_t budget_mb, const char* command);
 

@@ -30,7 +30,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
     for (const InstanceReferenceCheck& build : done.instance_checks) {
       CheckInstanceReferences(ctx, build);
-      if (warnings & kCaptureWarnNonFiniteTransform) ReportInstanceTransforms(ctx, build);
+      ReportInstanceTransforms(ctx, build, warnings, spacing_permille);
     }
     for (const IndirectRangeCheck& build : done.indirect_checks) CheckIndirectRanges(ctx, build);
     // Device serialization: the content of the bytes serialized, and the deserializations verified against it

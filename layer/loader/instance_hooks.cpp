@@ -132,9 +132,11 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
         instance->next_gipa(instance->instance, "vkSetDebugUtilsObjectNameEXT"));
   }
   data->state.history_tracked = instance->settings.TracksHistory();
-  data->state.instance_activity_snapshots = instance->settings.capture == kCaptureAll &&
-                                            (instance->settings.capture_warnings & kCaptureWarnDegenerateInstance) &&
-                                            instance->settings.Reports(kSeverityInfo);
+  const LayerSettings& settings = instance->settings;
+  data->state.instance_activity_snapshots =
+      settings.capture == kCaptureAll &&
+      (((settings.capture_warnings & kCaptureWarnDegenerateInstance) && settings.Reports(kSeverityInfo)) ||
+       (settings.capture_warnings & kCaptureWarnFloatSpacing));
   data->state.features = ParseEnabledFeatures(*pCreateInfo);
   QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
   data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);

@@ -94,12 +94,6 @@ bool PrimitiveBoxes(const CaptureLog& log, const CapturedGeometry& g, builder::B
   return false;
 }
 
-// The distance from |x| to the next larger float: how finely positions near x can be placed.
-float SpacingAt(float x) {
-  const float a = std::fabs(x);
-  return std::nextafter(a, INFINITY) - a;
-}
-
 // Whether a primitive's box is so far out that float spacing there exceeds permille / 1000 of its size.
 bool CoarselySpaced(const builder::PrimRef& box, uint32_t permille, float* magnitude, float* size) {
   float m = 0, extent = 0;
@@ -110,7 +104,7 @@ bool CoarselySpaced(const builder::PrimRef& box, uint32_t permille, float* magni
   if (!std::isfinite(m) || !std::isfinite(extent) || extent <= 0) return false;  // not a size to compare with
   *magnitude = m;
   *size = extent;
-  return static_cast<double>(SpacingAt(m)) * 1000.0 > static_cast<double>(permille) * extent;
+  return SpacingExceeds(m, extent, permille);
 }
 
 // The first NaN or infinite element of a geometry's captured transform, or -1 (none, or not captured).
@@ -119,6 +113,15 @@ int NonFiniteElement(const CaptureLog& log, const CapturedGeometry& g) {
 }
 
 }  // namespace
+
+float FloatSpacingAt(float x) {
+  const float a = std::fabs(x);
+  return std::nextafter(a, INFINITY) - a;
+}
+
+bool SpacingExceeds(float magnitude, float size, uint32_t permille) {
+  return static_cast<double>(FloatSpacingAt(magnitude)) * 1000.0 > static_cast<double>(permille) * size;
+}
 
 int FirstNonFiniteElement(const uint8_t* matrix) {
   for (int k = 0; k < 12; ++k) {
@@ -178,7 +181,9 @@ void BuildActivity::ScanSpacing(const CaptureLog& log, const CapturedInfo& info,
     found.geometry = j;
     for (const builder::PrimRef& box : boxes.refs) {
       float magnitude = 0, size = 0;
-      if (!CoarselySpaced(box, permille, &magnitude, &size)) continue;
+      const bool coarse = CoarselySpaced(box, permille, &magnitude, &size);
+      if (size > 0 && (smallest_ == 0 || size < smallest_)) smallest_ = size;
+      if (!coarse) continue;
       if (found.primitives++ == 0) {
         found.first_primitive = box.id;
         found.magnitude = magnitude;

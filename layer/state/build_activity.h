@@ -24,6 +24,11 @@ namespace asval {
 // transform of an instance record), as row * 4 + column; -1 when all twelve are finite.
 int FirstNonFiniteElement(const uint8_t* matrix);
 
+// The distance from |x| to the next larger 32-bit float: how finely positions near x can be placed.
+float FloatSpacingAt(float x);
+// Whether float spacing at `magnitude` exceeds permille / 1000 of `size` (ASVAL-Capture-FloatSpacing).
+bool SpacingExceeds(float magnitude, float size, uint32_t permille);
+
 class BuildActivity {
  public:
   enum class Status : uint8_t { kPending, kReady, kUnknown };
@@ -72,6 +77,9 @@ class BuildActivity {
   const std::vector<UndefinedInput>& undefined_input() const { return undefined_; }
   // kReady, when Fill scanned for it: the geometries with coarsely spaced primitives (usually none).
   const std::vector<CoarseSpacing>& coarse_spacing() const { return coarse_; }
+  // kReady, when Fill scanned for spacing: the smallest positive size (box extent) of its primitives; 0 when
+  // none or not scanned. An instance of it is judged by it (its translation's float spacing).
+  float smallest_primitive() const { return smallest_; }
   // kReady: no geometry has an active primitive (an instance of it is degenerate).
   bool NoActivePrimitive() const;
 
@@ -84,6 +92,7 @@ class BuildActivity {
   std::vector<builder::ActivityRecord> geometries_;
   std::vector<UndefinedInput> undefined_;
   std::vector<CoarseSpacing> coarse_;
+  float smallest_ = 0;
   OpOrigin origin_;
   VkAccelerationStructureKHR dst_ = VK_NULL_HANDLE;
 };

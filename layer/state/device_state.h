@@ -45,8 +45,9 @@ class DeviceState {
   // The settings enable a family that needs the build history (history, or copies for dst-03561): operations
   // are recorded and applied only then.
   bool history_tracked = true;
-  // Degenerate instances are reported (capture = all, the degenerate_instance capture warning, info severity):
-  // each captured top-level build keeps the activity of every live structure as of its submission.
+  // With capture = all, degenerate instances (the degenerate_instance capture warning, info severity) or instance
+  // translations (the float_spacing capture warning) are judged: each captured top-level build keeps the activity
+  // of every live structure as of its submission.
   bool instance_activity_snapshots = false;
 
   ConcurrentMap<VkDeviceMemory, std::shared_ptr<const MemoryState>> memories;

@@ -162,6 +162,29 @@ TEST_CASE("capture: with capture=all, an instance of a structure without active 
   rig.device().Destroy(instances);
 }
 
+TEST_CASE("capture: with capture=all and the float_spacing warning, an instance translated far for the primitives it "
+          "references is reported",
+          "[integration][capture]") {
+  HistoryFixture f(nullptr, {{"capture", "all"}, {"capture_warnings", kAll}});
+  Rig rig(f);
+  Tlas tlas(rig.device());
+  rig.Build(TwoTriangles(0.0f, 2.0f));  // unit triangles: the smallest primitive's size is 1
+  vkkit::Buffer instances = tlas.MakeInstances({&rig.blas(), &rig.blas()});
+  const auto translate = [&](uint32_t instance, float x) {
+    auto* records = static_cast<VkAccelerationStructureInstanceKHR*>(instances.mapped);
+    records[instance].transform.matrix[0][3] = x;
+  };
+  // Near 10^6 floats are 0.0625 apart: 62.5 thousandths of the smallest primitive, over the threshold of 10.
+  translate(1, 1.0e6f);
+  rig.Run([&](VkCommandBuffer cb) { tlas.Record(cb, instances, 2, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR); });
+  CHECK(OnlyFinding(f.monitor(), kFloatSpacing, "geometry 0: 1 instance(s) are translated so far") == "");
+  // The twin: near 10^3 (0.06 thousandths): silent.
+  translate(1, 1.0e3f);
+  rig.Run([&](VkCommandBuffer cb) { tlas.Record(cb, instances, 2, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR); });
+  CHECK(f.monitor().Verify() == "");
+  rig.device().Destroy(instances);
+}
+
 TEST_CASE("capture: with capture=updates (the default), degenerate instances are not reported",
           "[integration][capture]") {
   asval_test_common::TempReport report;
