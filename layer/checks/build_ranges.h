@@ -31,22 +31,22 @@ enum class RangeRule { kIndexOffset, kVertexOffset, kTransformOffset, kAabbOffse
 // captured ranges are judged by at completion (pIndirectDeviceAddresses-03651 names the rule it breaks).
 const char* RangeRuleVuid(RangeRule rule);
 
-// What the range rules read of one geometry. The record-time check takes them from the app's geometry
-// (GeometryFacts); an indirect build's check takes them from what the capture kept when the command was recorded
-// (its ranges are read by the device, so they are judged when the submission completes).
-struct RangeFacts {
-  VkGeometryTypeKHR type;
-  uint32_t component_bytes;  // triangles: vertexFormat's alignment unit (03657); 0: a format the table lacks
-  int index_size;            // triangles: IndexTypeSize(indexType)
-  uint32_t max_vertex;       // triangles
+// What the range rules read of one geometry, through accessors that JudgeRange calls only where a rule needs
+// the value (the triangle ones for triangles only):
+//   type()             the geometry type
+//   component_bytes()  triangles: vertexFormat's alignment unit (03657); 0: a format the vertex table lacks
+//   index_size()       triangles: IndexTypeSize(indexType)
+//   max_vertex()       triangles: maxVertex
+// The record-time check reads them from the app's geometry (below); an indirect build's check from what the
+// capture kept when the command was recorded (indirect_rules.cpp). Accessors, not a struct filled up front: on the
+// record-time hot path nothing is loaded before the rule that needs it, as when the rules read GeometryFacts.
+struct GeometryRangeFacts {
+  const GeometryFacts& f;
+  VkGeometryTypeKHR type() const { return f.geometry.geometryType; }
+  uint32_t component_bytes() const { return f.format.componentBytes; }
+  int index_size() const { return f.index_size; }
+  uint32_t max_vertex() const { return f.geometry.geometry.triangles.maxVertex; }
 };
-
-[[gnu::always_inline]] inline RangeFacts RangeFactsOf(const GeometryFacts& f) {
-  // Only a triangle geometry's union member is read: the other types' rules need no more than the type.
-  if (f.geometry.geometryType != VK_GEOMETRY_TYPE_TRIANGLES_KHR) return RangeFacts{f.geometry.geometryType, 0, 0, 0};
-  return RangeFacts{VK_GEOMETRY_TYPE_TRIANGLES_KHR, f.format.componentBytes, f.index_size,
-                    f.geometry.geometry.triangles.maxVertex};
-}
 
 [[gnu::cold, gnu::noinline]] bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                                               RangeRule rule);
@@ -60,16 +60,16 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
 // returns; indexed() is run for indexed triangles whose primitiveOffset is aligned (indices read from a
 // misaligned offset are not the app's indices), for what needs the indices themselves (maxVertex-10774, where
 // they can be read).
-template <typename Judge, typename Report, typename Indexed>
-[[gnu::always_inline]] inline bool JudgeRange(const RangeFacts& f, const VkAccelerationStructureBuildRangeInfoKHR& range,
+template <typename Facts, typename Judge, typename Report, typename Indexed>
+[[gnu::always_inline]] inline bool JudgeRange(const Facts& f, const VkAccelerationStructureBuildRangeInfoKHR& range,
                                               const Judge& judge, const Report& report, const Indexed& indexed) {
   const auto broken = [&](RangeRule rule) { return judge.Broken([&] { return report(rule); }); };
   bool skip = false;
-  switch (f.type) {
+  switch (f.type()) {
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
-      const int index_size = f.index_size;
+      const int index_size = f.index_size();
       if (index_size == 0) {
-        const uint32_t alignment = f.component_bytes;
+        const uint32_t alignment = f.component_bytes();
         if (alignment == 0) {
           skip |= judge.Unknown();
         } else if ((range.primitiveOffset & (alignment - 1)) != 0) {
@@ -78,8 +78,9 @@ template <typename Judge, typename Report, typename Indexed>
         // Nothing is read when there are no triangles (firstVertex then names no vertex).
         if (range.primitiveCount != 0) {
           const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
-          if (vertices > uint64_t{f.max_vertex} + 1) skip |= broken(RangeRule::kVertexCount);
-          if (uint64_t{range.firstVertex} + vertices - 1 > f.max_vertex) skip |= broken(RangeRule::kLastVertex);
+          const uint32_t max_vertex = f.max_vertex();
+          if (vertices > uint64_t{max_vertex} + 1) skip |= broken(RangeRule::kVertexCount);
+          if (uint64_t{range.firstVertex} + vertices - 1 > max_vertex) skip |= broken(RangeRule::kLastVertex);
         }
       } else if (index_size == 2 || index_size == 4) {
         if ((range.primitiveOffset & (index_size - 1)) != 0) {
@@ -120,7 +121,7 @@ template <typename Judge>
       return judge.Unknown();
     }
   };
-  return JudgeRange(RangeFactsOf(f), range, judge, report, indexed);
+  return JudgeRange(GeometryRangeFacts{f}, range, judge, report, indexed);
 }
 
 }  // namespace asval

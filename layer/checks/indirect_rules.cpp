@@ -114,12 +114,15 @@ void CheckUpdateCounts(const CheckContext& ctx, const IndirectRangeCheck& c, con
                                   c.build.element, named, AndMore(differ)));
 }
 
-// The range rules' facts of a captured geometry (range_facts set), as RangeFactsOf takes them at record time.
-RangeFacts CapturedRangeFacts(const CapturedGeometry& g) {
-  if (g.type != VK_GEOMETRY_TYPE_TRIANGLES_KHR) return RangeFacts{g.type, 0, 0, 0};
-  return RangeFacts{g.type, VertexFormatFacts(g.vertex_format).componentBytes, IndexTypeSize(g.index_type),
-                    g.max_vertex};
-}
+// The range rules' facts (build_ranges.h) of a captured geometry whose range_facts were kept: the geometry as
+// the command was recorded, read as the record-time check reads the app's.
+struct CapturedRangeFacts {
+  const CapturedGeometry& g;
+  VkGeometryTypeKHR type() const { return g.type; }
+  uint32_t component_bytes() const { return VertexFormatFacts(g.vertex_format).componentBytes; }
+  int index_size() const { return IndexTypeSize(g.index_type); }
+  uint32_t max_vertex() const { return g.max_vertex; }
+};
 
 // A broken range rule in words: the field, its value, what the rule asks of it, and the rule itself.
 std::string DescribeRange(RangeRule rule, const CapturedGeometry& g, const VkAccelerationStructureBuildRangeInfoKHR& r) {
@@ -181,7 +184,7 @@ void CheckCapturedRanges(const CheckContext& ctx, const IndirectRangeCheck& c, c
       }
       return false;  // the command ran long ago: there is no call to skip
     };
-    JudgeRange(CapturedRangeFacts(g), range, judge, note, [] { return false; });
+    JudgeRange(CapturedRangeFacts{g}, range, judge, note, [] { return false; });
   }
   CountSkips(ctx, unknown);
   if (broken == 0) return;
