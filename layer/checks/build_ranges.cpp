@@ -82,35 +82,28 @@ bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, u
   const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
   switch (rule) {
     case RangeRule::kIndexOffset:
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("primitiveOffset"), "({}) is not a multiple of {}, the size of the geometry's "
-                         "indexType {}.",
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
+                         "({}) is not a multiple of {}, the size of the geometry's indexType {}.",
                          range.primitiveOffset, IndexTypeSize(tri.indexType), string_VkIndexType(tri.indexType));
     case RangeRule::kVertexOffset: {
       const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
-                         range.primitiveOffset, alignment.bytes,
-                         alignment.What(),
-                         string_VkFormat(tri.vertexFormat));
+                         range.primitiveOffset, alignment.bytes, alignment.What(), string_VkFormat(tri.vertexFormat));
     }
     case RangeRule::kTransformOffset:
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("transformOffset"), "({}) is not a multiple of 16.", range.transformOffset);
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("transformOffset"),
+                         "({}) is not a multiple of 16.", range.transformOffset);
     case RangeRule::kAabbOffset:
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
                          range.primitiveOffset);
     case RangeRule::kInstanceOffset:
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
                          range.primitiveOffset);
     case RangeRule::kVertexCount:
-      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule),
-                         range_field("primitiveCount"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveCount"),
                          "({}) triangles consume {} vertices from vertexData, more than the geometry's maxVertex "
                          "({}) + 1.",
                          range.primitiveCount, vertices, tri.maxVertex);

@@ -125,7 +125,8 @@ struct CapturedRangeFacts {
 };
 
 // A broken range rule in words: the field, its value, what the rule asks of it, and the rule itself.
-std::string DescribeRange(RangeRule rule, const CapturedGeometry& g, const VkAccelerationStructureBuildRangeInfoKHR& r) {
+std::string DescribeRange(RangeRule rule, const CapturedGeometry& g,
+                          const VkAccelerationStructureBuildRangeInfoKHR& r) {
   const uint64_t vertices = uint64_t{r.primitiveCount} * 3;
   std::string what;
   switch (rule) {

@@ -61,12 +61,13 @@ std::vector<Range> CountRanges(const std::vector<uint32_t>& counts) {
 // apart, hold `ranges`; the command's maxima are `maxima`.
 struct IndirectLog {
   IndirectLog(const std::vector<uint32_t>& counts, const std::vector<uint32_t>& maxima, uint32_t stride)
-      : IndirectLog(CountRanges(counts), std::vector<CapturedGeometry>(counts.size(), Facts(VK_GEOMETRY_TYPE_AABBS_KHR)),
-                    maxima, stride) {}
+      : IndirectLog(CountRanges(counts),
+                    std::vector<CapturedGeometry>(counts.size(), Facts(VK_GEOMETRY_TYPE_AABBS_KHR)), maxima, stride) {}
 
   IndirectLog(const std::vector<Range>& ranges, const std::vector<CapturedGeometry>& geometries,
               const std::vector<uint32_t>& maxima, uint32_t stride)
-      : bytes(stride * ranges.size() + sizeof(Range)), log(std::make_shared<CaptureLog>(std::make_shared<HostSlabs>())) {
+      : bytes(stride * ranges.size() + sizeof(Range)),
+        log(std::make_shared<CaptureLog>(std::make_shared<HostSlabs>())) {
     for (std::size_t j = 0; j < ranges.size(); ++j) std::memcpy(bytes.data() + j * stride, &ranges[j], sizeof(Range));
     log->slabs.push_back(CaptureSlab{VK_NULL_HANDLE, VK_NULL_HANDLE, bytes.data(), bytes.size()});
     CapturedInfo info;
