@@ -78,6 +78,23 @@ void ResolveDestinations(const DeviceState& state, uint32_t info_count,
   }
 }
 
+// What the range rules need of an indirect build's geometry j (pIndirectDeviceAddresses-03651): its range is read
+// by the device, so it is judged at completion against the geometry as the app recorded it, copied now (the app's
+// structures need not outlive the call).
+void KeepRangeFacts(const VkAccelerationStructureBuildGeometryInfoKHR& info, uint32_t j, CapturedGeometry* out) {
+  const VkAccelerationStructureGeometryKHR* g =
+      info.pGeometries ? &info.pGeometries[j] : info.ppGeometries ? info.ppGeometries[j] : nullptr;
+  if (!g) return;  // range_facts stays false: judged by no one, counted
+  out->type = g->geometryType;
+  if (g->geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    const VkAccelerationStructureGeometryTrianglesDataKHR& t = g->geometry.triangles;
+    out->vertex_format = t.vertexFormat;
+    out->index_type = t.indexType;
+    out->max_vertex = t.maxVertex;
+  }
+  out->range_facts = true;
+}
+
 }  // namespace
 
 bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
@@ -91,7 +108,8 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
   }
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
   thread_local std::vector<Copy> copies;
-  thread_local std::vector<CapturedGeometry> planned;  // no geometry data: only the range infos are captured
+  // No geometry data (only the range infos are captured): the facts their rules need.
+  thread_local std::vector<CapturedGeometry> planned;
   copies.clear();
   for (uint32_t i = 0; i < info_count; ++i) {
     const uint32_t n = infos[i].geometryCount;
@@ -117,6 +135,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
     }
     planned.assign(n, CapturedGeometry{});
+    for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
     captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
   }
   if (!copies.empty()) RecordCopies(ctx, cb, copies);

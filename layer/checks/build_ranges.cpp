@@ -46,6 +46,26 @@ uint32_t LargestIndex(const uint8_t* data, uint64_t count, int size) {
 
 }  // namespace
 
+const char* RangeRuleVuid(RangeRule rule) {
+  switch (rule) {
+    case RangeRule::kIndexOffset:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656";
+    case RangeRule::kVertexOffset:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657";
+    case RangeRule::kTransformOffset:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-transformOffset-03658";
+    case RangeRule::kAabbOffset:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03659";
+    case RangeRule::kInstanceOffset:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03660";
+    case RangeRule::kVertexCount:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-vertexData-10418";
+    case RangeRule::kLastVertex:
+      return "VUID-VkAccelerationStructureBuildRangeInfoKHR-None-10775";
+  }
+  return "";
+}
+
 bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j, RangeRule rule) {
   const VkAccelerationStructureGeometryTrianglesDataKHR& tri = GeometryAt(cmd.infos[i], j)->geometry.triangles;
   const VkAccelerationStructureBuildRangeInfoKHR& range = cmd.ranges[i][j];
@@ -62,40 +82,33 @@ bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, u
   const uint64_t vertices = uint64_t{range.primitiveCount} * 3;
   switch (rule) {
     case RangeRule::kIndexOffset:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656",
-                         range_field("primitiveOffset"), "({}) is not a multiple of {}, the size of the geometry's "
-                         "indexType {}.",
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
+                         "({}) is not a multiple of {}, the size of the geometry's indexType {}.",
                          range.primitiveOffset, IndexTypeSize(tri.indexType), string_VkIndexType(tri.indexType));
     case RangeRule::kVertexOffset: {
       const VertexFormatAlignment alignment = AlignmentOfVertexFormat(tri.vertexFormat);
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657",
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of {} bytes, the {} of the non-indexed geometry's vertexFormat {}.",
-                         range.primitiveOffset, alignment.bytes,
-                         alignment.What(),
-                         string_VkFormat(tri.vertexFormat));
+                         range.primitiveOffset, alignment.bytes, alignment.What(), string_VkFormat(tri.vertexFormat));
     }
     case RangeRule::kTransformOffset:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-transformOffset-03658",
-                         range_field("transformOffset"), "({}) is not a multiple of 16.", range.transformOffset);
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("transformOffset"),
+                         "({}) is not a multiple of 16.", range.transformOffset);
     case RangeRule::kAabbOffset:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03659",
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of 8 (the geometry is VK_GEOMETRY_TYPE_AABBS_KHR).",
                          range.primitiveOffset);
     case RangeRule::kInstanceOffset:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03660",
-                         range_field("primitiveOffset"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveOffset"),
                          "({}) is not a multiple of 16 (the geometry is VK_GEOMETRY_TYPE_INSTANCES_KHR).",
                          range.primitiveOffset);
     case RangeRule::kVertexCount:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-vertexData-10418",
-                         range_field("primitiveCount"),
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), range_field("primitiveCount"),
                          "({}) triangles consume {} vertices from vertexData, more than the geometry's maxVertex "
                          "({}) + 1.",
                          range.primitiveCount, vertices, tri.maxVertex);
     case RangeRule::kLastVertex:
-      return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildRangeInfoKHR-None-10775", max_vertex,
+      return ReportBuild(ctx, cmd, i, RangeRuleVuid(rule), max_vertex,
                          "({}) is less than ppBuildRangeInfos[{}][{}].firstVertex ({}) + primitiveCount ({}) * 3 - 1 "
                          "= {}, the last vertex the non-indexed build reads.",
                          tri.maxVertex, i, j, range.firstVertex, range.primitiveCount,

@@ -81,6 +81,11 @@ struct CapturedGeometry {
   // Instances given as an array of pointers: `data` holds the pointers (8 bytes each) the device read, not the
   // records they point to, which the layer cannot locate when it records the copies.
   bool array_of_pointers = false;
+  // Indirect infos: what the range rules judge their captured range by (pIndirectDeviceAddresses-03651) was kept
+  // when the command was recorded: type, and for triangles vertex_format, index_type and max_vertex, the app's
+  // own (max_vertex not rewritten: firstVertex is in the range, on the device). False: the geometry could not be
+  // read (a null element of ppGeometries); its range is not judged (skipped and counted). The bytes stay absent.
+  bool range_facts = false;
   builder::BuildRange range;  // primitiveCount, and the offsets still to apply to the captured bytes
   CapturedBytes data;         // vertices (triangles) or AABB records
   CapturedBytes indices;      // indexed triangles

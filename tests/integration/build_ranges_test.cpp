@@ -1,5 +1,6 @@
 // Family "structure", VkAccelerationStructureBuildRangeInfoKHR: offsets and vertex counts of the ranges the
-// app passes on the host, for the direct and the host build (an indirect build's ranges are device memory).
+// app passes on the host, for the direct and the host build (an indirect build's ranges are device memory,
+// judged on their capture: tests/unit/indirect_capture_unit_test.cpp).
 // Host builds get host addresses into the scene's mapped buffer, since maxVertex-10774 reads their indices.
 #include <catch2/catch_test_macros.hpp>
 

@@ -1,7 +1,8 @@
 // The rules an indirect build's captured range infos are judged by (ppMaxPrimitiveCounts-03653; for updates,
-// primitiveCount-03769), at unit level on captured bytes: neither lavapipe nor the H200 builds indirectly, so no
-// capture runs through a driver. The log is made by hand as layer/capture would fill it (the range infos copied
-// from pIndirectDeviceAddresses[i], strided).
+// primitiveCount-03769; the range rules, pIndirectDeviceAddresses-03651), at unit level on captured bytes: neither
+// lavapipe nor the H200 builds indirectly, so no capture runs through a driver. The log is made by hand as
+// layer/capture would fill it (the range infos copied from pIndirectDeviceAddresses[i], strided; per geometry the
+// facts the range rules need); what the recorder keeps is tested on its own, over a fake next dispatch table.
 #include <catch2/catch_test_macros.hpp>
 
 #include <cstring>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "capture_recorder.h"
 #include "history_apply.h"
 #include "history_test_builds.h"
 #include "indirect_rules.h"
@@ -20,6 +22,7 @@ namespace {
 
 constexpr const char* kOverMaximum = "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-ppMaxPrimitiveCounts-03653";
 constexpr const char* kCountChanged = "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-primitiveCount-03769";
+constexpr const char* kRangeInvalid = "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pIndirectDeviceAddresses-03651";
 constexpr VkBuildAccelerationStructureFlagsKHR kUpdatable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
 
 // Host memory standing in for a slab (never given back to a pool).
@@ -29,24 +32,51 @@ class HostSlabs : public CaptureSlabOwner {
   void Return(const CaptureSlab&) override {}
 };
 
-// A log with one indirect info of counts.size() geometries whose range infos, `stride` bytes apart, hold
-// `counts`; the command's maxima are `maxima`.
+using Range = VkAccelerationStructureBuildRangeInfoKHR;
+
+// A captured geometry's facts as the recorder keeps them for an indirect build (range_facts set).
+CapturedGeometry Facts(VkGeometryTypeKHR type) {
+  CapturedGeometry g;
+  g.type = type;
+  g.range_facts = true;
+  return g;
+}
+
+CapturedGeometry Triangles(VkFormat format, VkIndexType index_type, uint32_t max_vertex) {
+  CapturedGeometry g = Facts(VK_GEOMETRY_TYPE_TRIANGLES_KHR);
+  g.vertex_format = format;
+  g.index_type = index_type;
+  g.max_vertex = max_vertex;
+  return g;
+}
+
+// Counts alone: AABB geometries, every offset 0 (valid for the range rules, which then stay silent).
+std::vector<Range> CountRanges(const std::vector<uint32_t>& counts) {
+  std::vector<Range> ranges;
+  for (uint32_t count : counts) ranges.push_back(Range{count, 0, 0, 0});
+  return ranges;
+}
+
+// A log with one indirect info of ranges.size() geometries (facts `geometries`) whose range infos, `stride` bytes
+// apart, hold `ranges`; the command's maxima are `maxima`.
 struct IndirectLog {
   IndirectLog(const std::vector<uint32_t>& counts, const std::vector<uint32_t>& maxima, uint32_t stride)
-      : bytes(stride * counts.size() + sizeof(VkAccelerationStructureBuildRangeInfoKHR)),
+      : IndirectLog(CountRanges(counts),
+                    std::vector<CapturedGeometry>(counts.size(), Facts(VK_GEOMETRY_TYPE_AABBS_KHR)), maxima, stride) {}
+
+  IndirectLog(const std::vector<Range>& ranges, const std::vector<CapturedGeometry>& geometries,
+              const std::vector<uint32_t>& maxima, uint32_t stride)
+      : bytes(stride * ranges.size() + sizeof(Range)),
         log(std::make_shared<CaptureLog>(std::make_shared<HostSlabs>())) {
-    for (std::size_t j = 0; j < counts.size(); ++j) {
-      VkAccelerationStructureBuildRangeInfoKHR range{counts[j], 0, 0, 0};
-      std::memcpy(bytes.data() + j * stride, &range, sizeof(range));
-    }
+    for (std::size_t j = 0; j < ranges.size(); ++j) std::memcpy(bytes.data() + j * stride, &ranges[j], sizeof(Range));
     log->slabs.push_back(CaptureSlab{VK_NULL_HANDLE, VK_NULL_HANDLE, bytes.data(), bytes.size()});
     CapturedInfo info;
     info.indirect = true;
-    info.geometry_count = static_cast<uint32_t>(counts.size());
+    info.geometry_count = static_cast<uint32_t>(ranges.size());
     info.ranges = CapturedBytes{0, 0, bytes.size(), true};
     info.indirect_stride = stride;
     log->infos.push_back(info);
-    log->geometries.resize(counts.size());
+    log->geometries = geometries;
     log->max_primitive_counts = maxima;
   }
 
@@ -87,7 +117,8 @@ TEST_CASE("indirect capture unit: range infos the layer cannot vouch for are ski
   for (IndirectLog* log : {&overlapped, &missing}) {
     const uint64_t before = h.state().checks_skipped_unknown_state.load();
     CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, log->Check()); }).empty());
-    CHECK(h.state().checks_skipped_unknown_state.load() == before + 1);
+    // The maximum (03653) once, and the one geometry's range (03651).
+    CHECK(h.state().checks_skipped_unknown_state.load() == before + 2);
   }
 }
 
@@ -240,8 +271,246 @@ TEST_CASE("indirect capture unit: an indirect update whose captured ranges canno
   const Submitted update = Submit(h.state(), Indirect(Build(a, {0, 0}, kUpdatable, a), &overlapped));
   CHECK(update.vuids.empty());
   CHECK(Complete(h, update).empty());
-  // The maximum (03653) once, and each of the two counts 03769 would have compared.
-  CHECK(h.state().checks_skipped_unknown_state.load() == skipped + 3);
+  // The maximum (03653) once, each of the two geometries' ranges (03651), and each of the two counts 03769 would
+  // have compared.
+  CHECK(h.state().checks_skipped_unknown_state.load() == skipped + 5);
+}
+
+// ---- pIndirectDeviceAddresses-03651: the range rules on captured range infos ----------------------------------
+
+// The range rules' VUIDs as 03651's findings name them: the rule's own VUID without "VUID-".
+constexpr const char* kNamesARule = "(VkAccelerationStructureBuildRangeInfoKHR-";
+
+std::size_t Occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// One broken range: geometry 1 of an info whose geometry 0 (AABBs at offset 0) is valid, so the finding must
+// name the right geometry and read its range at the right stride.
+struct BrokenRange {
+  const char* rule;
+  CapturedGeometry geometry;
+  Range range;
+  std::vector<std::string> findings;  // each, in full, in the message (and no other rule named)
+};
+
+std::vector<BrokenRange> BrokenRanges() {
+  return {
+      {"03656, 32-bit indices", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT32, 100), Range{1, 6, 0, 0},
+       {"geometry 1: primitiveOffset 6 is not a multiple of the index size 4 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656)"}},
+      {"03656, 16-bit indices", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT16, 100), Range{1, 3, 0, 0},
+       {"geometry 1: primitiveOffset 3 is not a multiple of the index size 2 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656)"}},
+      {"03657, 32-bit components", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 100),
+       Range{1, 6, 0, 0},
+       {"geometry 1: primitiveOffset 6 is not a multiple of 4 bytes, the component size of the non-indexed "
+        "vertexFormat VK_FORMAT_R32G32B32_SFLOAT (VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657)"}},
+      {"03657, 16-bit components", Triangles(VK_FORMAT_R16G16B16A16_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 100),
+       Range{1, 3, 0, 0},
+       {"geometry 1: primitiveOffset 3 is not a multiple of 2 bytes, the component size of the non-indexed "
+        "vertexFormat VK_FORMAT_R16G16B16A16_SFLOAT (VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657)"}},
+      {"03657, a packed format", Triangles(VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_INDEX_TYPE_NONE_KHR, 100),
+       Range{1, 2, 0, 0},
+       {"geometry 1: primitiveOffset 2 is not a multiple of 4 bytes, the size of the packed format of the "
+        "non-indexed vertexFormat VK_FORMAT_A2B10G10R10_UNORM_PACK32 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657)"}},
+      {"03658", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT32, 100), Range{1, 0, 0, 8},
+       {"geometry 1: transformOffset 8 is not a multiple of 16 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-transformOffset-03658)"}},
+      {"03659", Facts(VK_GEOMETRY_TYPE_AABBS_KHR), Range{1, 4, 0, 0},
+       {"geometry 1: primitiveOffset 4 is not a multiple of 8 (AABBs) "
+        "(VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03659)"}},
+      {"03660", Facts(VK_GEOMETRY_TYPE_INSTANCES_KHR), Range{1, 8, 0, 0},
+       {"geometry 1: primitiveOffset 8 is not a multiple of 16 (instances) "
+        "(VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03660)"}},
+      // More vertices than maxVertex + 1 always also reads past maxVertex: 10418 never comes alone.
+      {"10418 (and 10775)", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 5), Range{3, 0, 0, 0},
+       {"geometry 1: primitiveCount 3 consumes 9 vertices, more than maxVertex 5 + 1 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-vertexData-10418)",
+        "geometry 1: firstVertex 0 + primitiveCount 3 * 3 - 1 = 8 is past maxVertex 5 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-None-10775)"}},
+      {"10775", Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 8), Range{3, 0, 1, 0},
+       {"geometry 1: firstVertex 1 + primitiveCount 3 * 3 - 1 = 9 is past maxVertex 8 "
+        "(VkAccelerationStructureBuildRangeInfoKHR-None-10775)"}},
+  };
+}
+
+TEST_CASE("indirect capture unit: each range rule a captured range info breaks fires pIndirectDeviceAddresses-03651, "
+          "naming the geometry, the field and the rule",
+          "[unit][capture][structure]") {
+  RecordHarness h;
+  for (const BrokenRange& c : BrokenRanges()) {
+    for (uint32_t stride : {16u, 32u}) {
+      INFO(c.rule << ", stride " << stride);
+      const IndirectLog log({Range{1, 0, 0, 0}, c.range}, {Facts(VK_GEOMETRY_TYPE_AABBS_KHR), c.geometry},
+                            {kRoomy, kRoomy}, stride);
+      const uint64_t skipped = h.state().checks_skipped_unknown_state.load();
+      CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, log.Check()); }) ==
+            std::vector<std::string>{kRangeInvalid});
+      REQUIRE(h.texts().size() == 1);
+      const std::string& text = h.texts()[0];
+      for (const std::string& finding : c.findings) CHECK(text.find(finding) != std::string::npos);
+      CHECK(Occurrences(text, kNamesARule) == c.findings.size());
+      CHECK(text.find("pIndirectDeviceAddresses[0]") != std::string::npos);
+      CHECK(text.find("geometry 0") == std::string::npos);
+      CHECK(h.state().checks_skipped_unknown_state.load() == skipped);
+    }
+  }
+}
+
+TEST_CASE("indirect capture unit: pIndirectDeviceAddresses-03651 names four findings and counts the rest",
+          "[unit][capture][structure]") {
+  RecordHarness h;
+  const std::vector<Range> misaligned(6, Range{1, 4, 0, 0});
+  const IndirectLog log(misaligned, std::vector<CapturedGeometry>(6, Facts(VK_GEOMETRY_TYPE_AABBS_KHR)),
+                        std::vector<uint32_t>(6, kRoomy), 16);
+  CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, log.Check()); }) ==
+        std::vector<std::string>{kRangeInvalid});
+  REQUIRE(h.texts().size() == 1);
+  CHECK(Occurrences(h.texts()[0], kNamesARule) == 4);
+  CHECK(h.texts()[0].find("geometry 3: primitiveOffset 4") != std::string::npos);
+  CHECK(h.texts()[0].find("(and 2 more findings)") != std::string::npos);
+}
+
+TEST_CASE("indirect capture unit: pIndirectDeviceAddresses-03651 valid twin: captured ranges valid for every kind of "
+          "geometry stay silent",
+          "[unit][capture][structure]") {
+  constexpr auto kSpheres = static_cast<VkGeometryTypeKHR>(1000429004);  // VK_GEOMETRY_TYPE_SPHERES_NV
+  const std::vector<std::pair<CapturedGeometry, Range>> valid = {
+      {Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT16, 10), Range{1, 2, 0, 0}},
+      // Indexed: firstVertex is judged with the indices (10774), which stay on the device.
+      {Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT32, 10), Range{1, 8, 50, 32}},
+      // Exactly maxVertex + 1 vertices, the last one maxVertex.
+      {Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 8), Range{3, 12, 0, 16}},
+      {Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 11), Range{3, 4, 3, 0}},
+      {Triangles(VK_FORMAT_R16G16B16A16_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 2), Range{1, 2, 0, 0}},
+      {Triangles(VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_INDEX_TYPE_NONE_KHR, 2), Range{1, 4, 0, 0}},
+      {Triangles(VK_FORMAT_R8G8B8A8_SNORM, VK_INDEX_TYPE_NONE_KHR, 2), Range{1, 1, 0, 0}},
+      // No triangles: nothing is read, firstVertex names no vertex.
+      {Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 0), Range{0, 0, 100, 0}},
+      {Facts(VK_GEOMETRY_TYPE_AABBS_KHR), Range{2, 8, 0, 0}},
+      {Facts(VK_GEOMETRY_TYPE_INSTANCES_KHR), Range{2, 16, 0, 0}},
+      // Geometry types of newer extensions have rules of their own.
+      {Facts(kSpheres), Range{1, 3, 0, 5}},
+  };
+  std::vector<CapturedGeometry> geometries;
+  std::vector<Range> ranges;
+  for (const auto& [geometry, range] : valid) {
+    geometries.push_back(geometry);
+    ranges.push_back(range);
+  }
+  RecordHarness h;
+  for (uint32_t stride : {16u, 32u}) {
+    INFO("stride " << stride);
+    const IndirectLog log(ranges, geometries, std::vector<uint32_t>(valid.size(), kRoomy), stride);
+    const uint64_t skipped = h.state().checks_skipped_unknown_state.load();
+    CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, log.Check()); }).empty());
+    CHECK(h.state().checks_skipped_unknown_state.load() == skipped);  // every range judged
+  }
+}
+
+TEST_CASE("indirect capture unit: pIndirectDeviceAddresses-03651 skips and counts a geometry whose facts are unknown, "
+          "and judges the others",
+          "[unit][capture][structure]") {
+  RecordHarness h;
+  // Geometry 0: its facts were not kept (a null element of ppGeometries); geometry 1: a vertex format the table
+  // does not describe, so 03657 has no unit to judge by (its vertex counts are judged: within maxVertex).
+  CapturedGeometry unread;  // range_facts false
+  unread.type = VK_GEOMETRY_TYPE_AABBS_KHR;
+  const CapturedGeometry depth = Triangles(VK_FORMAT_D32_SFLOAT, VK_INDEX_TYPE_NONE_KHR, 2);
+  const Range odd{1, 3, 0, 0};  // off every unit but 1
+
+  const IndirectLog unknown({odd, odd}, {unread, depth}, {kRoomy, kRoomy}, 16);
+  uint64_t skipped = h.state().checks_skipped_unknown_state.load();
+  CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, unknown.Check()); }).empty());
+  CHECK(h.state().checks_skipped_unknown_state.load() == skipped + 2);
+
+  // With a third, AABB geometry at the same offset: only it is reported.
+  const IndirectLog third({odd, odd, odd}, {unread, depth, Facts(VK_GEOMETRY_TYPE_AABBS_KHR)},
+                          {kRoomy, kRoomy, kRoomy}, 16);
+  skipped = h.state().checks_skipped_unknown_state.load();
+  CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, third.Check()); }) ==
+        std::vector<std::string>{kRangeInvalid});
+  REQUIRE(h.texts().size() == 1);
+  CHECK(h.texts()[0].find("geometry 2: primitiveOffset 3 is not a multiple of 8 (AABBs)") != std::string::npos);
+  CHECK(Occurrences(h.texts()[0], kNamesARule) == 1);
+  CHECK(h.state().checks_skipped_unknown_state.load() == skipped + 2);
+}
+
+TEST_CASE("indirect capture unit: pIndirectDeviceAddresses-03651 follows the structure family", "[unit][capture]") {
+  RecordHarness h;
+  const IndirectLog log({Range{1, 4, 0, 0}}, {Facts(VK_GEOMETRY_TYPE_AABBS_KHR)}, {kRoomy}, 16);
+  const uint64_t skipped = h.state().checks_skipped_unknown_state.load();
+  CHECK(h.RunCheck([&](const CheckContext& ctx) { CheckIndirectRanges(ctx, log.Check()); },
+                   kRecordFamilies & ~uint32_t{kCheckStructure})
+            .empty());
+  CHECK(h.state().checks_skipped_unknown_state.load() == skipped);  // off: not a check skipped
+}
+
+// ---- what the recorder keeps of an indirect build's geometries ------------------------------------------------
+
+void VKAPI_CALL NoCopy(VkCommandBuffer, VkBuffer, VkBuffer, uint32_t, const VkBufferCopy*) {}
+void VKAPI_CALL NoBarrier(VkCommandBuffer, VkPipelineStageFlags, VkPipelineStageFlags, VkDependencyFlags, uint32_t,
+                          const VkMemoryBarrier*, uint32_t, const VkBufferMemoryBarrier*, uint32_t,
+                          const VkImageMemoryBarrier*) {}
+
+TEST_CASE("indirect capture unit: the recorder keeps each geometry's range facts as recorded, a null geometry's as "
+          "unknown",
+          "[unit][capture]") {
+  RecordHarness h;
+  DeviceDispatchTable next{};
+  next.CmdCopyBuffer = NoCopy;
+  next.CmdPipelineBarrier = NoBarrier;
+  // No memory type: the pool gives no slab. No buffer holds the address either, so the info is logged as not
+  // captured; its geometries' facts are kept all the same (what this test reads).
+  const auto pool = std::make_shared<CapturePool>(VK_NULL_HANDLE, next, VkPhysicalDeviceMemoryProperties{});
+  CaptureCounters counters;
+  const CaptureContext ctx{h.state(), next, *pool, kCaptureUpdates, VkDeviceSize{1} << 20, counters};
+  CommandBufferState recording(VK_NULL_HANDLE, VK_COMMAND_BUFFER_LEVEL_PRIMARY, false);
+
+  VkAccelerationStructureGeometryKHR triangles{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  triangles.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  triangles.geometry.triangles.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  triangles.geometry.triangles.vertexFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+  triangles.geometry.triangles.indexType = VK_INDEX_TYPE_UINT16;
+  triangles.geometry.triangles.maxVertex = 41;
+  VkAccelerationStructureGeometryKHR aabbs{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  aabbs.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
+  aabbs.geometry.aabbs.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
+  const VkAccelerationStructureGeometryKHR* geometries[] = {&triangles, nullptr, &aabbs};
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.geometryCount = 3;
+  info.ppGeometries = geometries;
+  const VkDeviceAddress address = 0x10000;
+  const uint32_t stride = 16;
+  const uint32_t maxima[] = {1, 1, 1};
+  const uint32_t* const max_counts[] = {maxima};
+  std::vector<uint32_t> captured;
+  REQUIRE(CaptureIndirectRanges(ctx, reinterpret_cast<VkCommandBuffer>(uintptr_t{0x20}), recording, 1, &info,
+                                &address, &stride, max_counts, captured));
+  // The app's structures may change or go once the call returns: the log holds copies.
+  triangles.geometry.triangles.maxVertex = 0;
+  triangles.geometry.triangles.indexType = VK_INDEX_TYPE_NONE_KHR;
+  triangles.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+
+  REQUIRE(recording.capture_log);
+  const CaptureLog& log = *recording.capture_log;
+  REQUIRE(log.infos.size() == 1);
+  REQUIRE(log.geometries.size() == 3);
+  const CapturedGeometry& tri = log.geometries[0];
+  CHECK(tri.range_facts);
+  CHECK(tri.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR);
+  CHECK(tri.vertex_format == VK_FORMAT_R16G16B16A16_SFLOAT);
+  CHECK(tri.index_type == VK_INDEX_TYPE_UINT16);
+  CHECK(tri.max_vertex == 41);
+  CHECK_FALSE(tri.data.present);  // only the range infos are captured
+  CHECK_FALSE(log.geometries[1].range_facts);
+  CHECK(log.geometries[2].range_facts);
+  CHECK(log.geometries[2].type == VK_GEOMETRY_TYPE_AABBS_KHR);
 }
 
 }  // namespace
