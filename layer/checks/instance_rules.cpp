@@ -60,9 +60,6 @@ std::string Referencing(const Referenced& r, const AccelerationStructureState& s
                      r.instance, Hex(s.handle), s.device_address);
 }
 
-// pInfos-03709: the buffer the referenced structure was created on is bound to device memory when the build
-// executes. Judged on the structure the snapshot saw, if it is still that structure now (destroyed since: nothing
-// concluded).
 [[gnu::cold]] void ReportStorageLost(const CheckContext& ctx, const InstanceReferenceCheck& c, const Referenced& r,
                                      const AccelerationStructureState& s, const char* why) {
   Report(ctx, c, "pInfos-03709", s.handle,
@@ -75,26 +72,27 @@ bool StillTheSame(const DeviceState& state, const AccelerationStructureState& s)
   return now && *now && (*now)->device_address == s.device_address && (*now)->buffer_id == s.buffer_id;
 }
 
-// The buffer the referenced structure was created on, when it is still bound to memory; else null, and, when
-// `report`, pInfos-03709 reported (counted in *findings). Judged on the structure the snapshot saw, if it is still
-// that structure now (destroyed since: nothing concluded, counted).
-std::shared_ptr<const BufferState> BoundStorage(const CheckContext& ctx, const InstanceReferenceCheck& c,
-                                                const Referenced& r, const AccelerationStructureState& s, bool report,
-                                                uint32_t* findings) {
-  if (s.buffer_id == 0 || !StillTheSame(ctx.state, s)) {
-    CountUnknownState(ctx);
-    return nullptr;
+// pInfos-03709: the buffer the referenced structure was created on was bound to memory when the build was
+// submitted (the snapshot of live structures says).
+uint32_t CheckStorage(const CheckContext& ctx, const InstanceReferenceCheck& c, const Referenced& r,
+                      const AccelerationStructureState& s, StructureStorage storage) {
+  switch (storage) {
+    case StructureStorage::kBound:
+      return 0;
+    case StructureStorage::kUnknown:
+      CountUnknownState(ctx);
+      return 0;
+    case StructureStorage::kBufferDestroyed:
+      ReportStorageLost(ctx, c, r, s, "was destroyed");
+      return 1;
+    case StructureStorage::kMemoryFreed:
+      ReportStorageLost(ctx, c, r, s, "has had its memory freed");
+      return 1;
+    case StructureStorage::kUnbound:
+      ReportStorageLost(ctx, c, r, s, "is bound to no memory");
+      return 1;
   }
-  std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, s);
-  if (buffer && buffer->bound && buffer->memory != VK_NULL_HANDLE) return buffer;
-  if (report) {
-    ReportStorageLost(ctx, c, r, s,
-                      !buffer               ? "was destroyed"
-                      : buffer->memory_freed ? "has had its memory freed"
-                                             : "is bound to no memory");
-    ++*findings;
-  }
-  return nullptr;
+  return 0;
 }
 
 // None-03407 and dstAccelerationStructure-03706: the referenced structure against the other destinations of the
@@ -134,16 +132,20 @@ uint32_t CheckAgainstDestinations(const CheckContext& ctx, const InstanceReferen
 // The rules about one structure the build's instances reference (each family as the settings enable it).
 // Returns the findings made (for the cap).
 uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
-                         const CapturedInfo& info, const Referenced& r,
-                         const std::shared_ptr<const AccelerationStructureState>& structure) {
-  const bool storage = ctx.Enabled(kCheckHandles);
-  const bool destinations = ctx.Enabled(kCheckAliasing) && info.destination_count != 0;
-  if (!storage && !destinations) return 0;
+                         const CapturedInfo& info, const Referenced& r, std::size_t k) {
+  const LiveStructureAddresses& live = *c.live;
+  const std::shared_ptr<const AccelerationStructureState>& structure = live.structures[k];
   uint32_t findings = 0;
-  const std::shared_ptr<const BufferState> buffer = BoundStorage(ctx, c, r, *structure, storage, &findings);
-  if (!destinations) return findings;
-  // The whole structure: which of its bytes the build reads is the driver's business.
-  const std::optional<MemorySpan> span = buffer ? StructureMemory{structure, buffer}.Span() : std::nullopt;
+  if (ctx.Enabled(kCheckHandles)) findings += CheckStorage(ctx, c, r, *structure, live.storage[k]);
+  if (!ctx.Enabled(kCheckAliasing) || info.destination_count == 0) return findings;
+  // The structure's memory now (it cannot move while the build is pending); whole: which of its bytes the build
+  // reads is the driver's business. Unknown when it was destroyed since, or its storage is not bound.
+  std::optional<MemorySpan> span;
+  if (live.storage[k] == StructureStorage::kBound && StillTheSame(ctx.state, *structure)) {
+    if (std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, *structure)) {
+      span = StructureMemory{structure, std::move(buffer)}.Span();
+    }
+  }
   return findings + CheckAgainstDestinations(ctx, c, log, info, r, *structure, span);
 }
 
@@ -180,7 +182,13 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   }
   const CapturedInfo& info = *readable;
   const LiveStructureAddresses& live = *c.live;
-  std::vector<Referenced> referenced;  // per completed build, not per recorded call
+  // The rules about each referenced structure (03709, the same command's destinations, degenerate instances) run
+  // only where one can have something to say: a frame whose structures are all bound, built in commands of their
+  // own, walks the instances once, for 06707.
+  const bool per_structure = !live.all_bound || info.destination_count != 0 || !c.activities.empty();
+  // Per live structure: the first instance that references it (structure -1: none).
+  std::vector<Referenced> first;
+  if (per_structure) first.assign(live.structures.size(), Referenced{-1, 0, 0});
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0 || !g.data.present) continue;
@@ -198,8 +206,8 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       if (reference == 0) continue;  // an inactive instance
       const std::ptrdiff_t structure = live.Find(reference);
       if (structure >= 0) {
-        if (referenced.empty() || referenced.back().structure != structure) {
-          referenced.push_back(Referenced{structure, j, k});
+        if (per_structure && first[static_cast<std::size_t>(structure)].structure < 0) {
+          first[static_cast<std::size_t>(structure)] = Referenced{structure, j, k};
         }
         continue;
       }
@@ -214,20 +222,16 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     if (bad != 0) ReportStale(ctx, c, j, bad, named);
   }
   // Each referenced structure once, named by the first instance that references it.
-  std::stable_sort(referenced.begin(), referenced.end(),
-                   [](const Referenced& a, const Referenced& b) { return a.structure < b.structure; });
-  referenced.erase(std::unique(referenced.begin(), referenced.end(),
-                               [](const Referenced& a, const Referenced& b) { return a.structure == b.structure; }),
-                   referenced.end());
   uint32_t findings = 0;
-  for (const Referenced& r : referenced) {
+  for (const Referenced& r : first) {
+    if (r.structure < 0) continue;
     const auto k = static_cast<std::size_t>(r.structure);
     const std::shared_ptr<const AccelerationStructureState>& structure = live.structures[k];
     if (k < c.activities.size() && c.activities[k] && c.activities[k]->NoActivePrimitive()) {
       ReportDegenerateInstance(ctx, c, r.geometry, r.instance, structure->handle, structure->device_address);
     }
     if (findings >= kMaxStructureFindings) continue;
-    findings += CheckReferenced(ctx, c, *log, info, r, structure);
+    findings += CheckReferenced(ctx, c, *log, info, r, k);
   }
 }
 

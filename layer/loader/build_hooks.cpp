@@ -101,10 +101,12 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
   cmd.infos = pInfos;
   cmd.ranges = ppBuildRangeInfos;
   // The inputs of updatable builds and updates, copied now (host memory): the activity rules judge them, and the
-  // history keeps their activity.
+  // history keeps their activity. Only on a device with host commands enabled: otherwise the call is invalid
+  // (features family) and its pointers, which may be device addresses, are never read.
   HostCapture capture;
   const LayerSettings& settings = data->instance->settings;
-  if (settings.capture != kCaptureOff && data->state.history_tracked) {
+  if (settings.capture != kCaptureOff && data->state.history_tracked &&
+      data->state.features.acceleration_structure_host_commands) {
     capture = CaptureHostBuildInputs(infoCount, pInfos, ppBuildRangeInfos, VkDeviceSize{settings.capture_budget_mb} << 20,
                                      data->state.capture_counters);
     cmd.host_capture = capture.log.get();

@@ -69,6 +69,9 @@ class DeviceState {
 
   // The device addresses of the live structures, as a top-level build submitted now must see them (capture).
   LiveStructureAddressCache live_structure_addresses;
+  // Bumped when a buffer with ACCELERATION_STRUCTURE_STORAGE usage is bound, destroyed or has its memory freed: a
+  // structure's storage may have changed (the snapshot above is taken again).
+  ChangeStamp structure_storage_changes;
   // Execution-time capture (layer/capture): what it captured, and could not.
   mutable CaptureCounters capture_counters;
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the

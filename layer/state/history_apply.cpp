@@ -121,6 +121,17 @@ IndirectRangeCheck IndirectCheck(const HistoryStore& store, const AsOp& op, Capt
   return check;
 }
 
+// Whether a live structure's storage is bound now (pInfos-03709), for the snapshot of live structures.
+StructureStorage StorageOfStructure(const DeviceState& state, const AccelerationStructureState& structure) {
+  if (structure.buffer_id == 0) return StructureStorage::kUnknown;  // created on a buffer the layer never saw
+  const std::shared_ptr<const BufferState> buffer = BufferOfStructure(state, structure);
+  if (!buffer) return StructureStorage::kBufferDestroyed;
+  // Sparse buffers are bound by vkQueueBindSparse, which the layer does not follow.
+  if (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return StructureStorage::kUnknown;
+  if (buffer->bound && buffer->memory != VK_NULL_HANDLE) return StructureStorage::kBound;
+  return buffer->memory_freed ? StructureStorage::kMemoryFreed : StructureStorage::kUnbound;
+}
+
 // A captured build's activity, filled when its submission completes; an update's comparison with its source's.
 // The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
 // one call) holds the bytes of the last execution only: both are unknown.
@@ -145,7 +156,10 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     InstanceReferenceCheck check;
     check.log = log->shared_from_this();
     check.info = op.capture_info;
-    check.live = state.live_structure_addresses.Get(state.acceleration_structures);
+    check.live = state.live_structure_addresses.Get(state.acceleration_structures,
+                                                    state.structure_storage_changes.Read(), [&](const auto& structure) {
+                                                      return StorageOfStructure(state, structure);
+                                                    });
     if (state.instance_activity_snapshots) {
       check.activities.reserve(check.live->structures.size());
       for (const auto& structure : check.live->structures) {

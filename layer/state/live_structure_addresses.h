@@ -1,9 +1,10 @@
 #pragma once
 // The device addresses of the acceleration structures alive at one point of submission order (execution-time
 // capture, issue 12): a top-level build's instances are checked against the structures that were alive when the
-// build was submitted (pInfos-06707), once its captured instances are read. One sorted snapshot is shared by every
-// submission until a structure is created or destroyed (the map's change stamp), so a frame that creates none
-// costs a stamp compare.
+// build was submitted (pInfos-06707), once its captured instances are read, with whether each one's storage was
+// bound then (pInfos-03709). One sorted snapshot is shared by every submission until a structure is created or
+// destroyed (the map's change stamp) or a structure's storage is bound, destroyed or freed, so a frame that does
+// none of these costs two stamp compares.
 #include <vulkan/vulkan.h>
 
 #include <algorithm>
@@ -19,10 +20,17 @@
 
 namespace asval {
 
+// Whether a live structure's storage is bound to memory (pInfos-03709: the buffer it was created on must be), as
+// known when the snapshot was taken.
+enum class StructureStorage : uint8_t { kBound, kBufferDestroyed, kMemoryFreed, kUnbound, kUnknown };
+
 struct LiveStructureAddresses {
   std::vector<VkDeviceAddress> addresses;  // sorted
-  // structures[k] has addresses[k] (the record as it was when the snapshot was taken).
+  // structures[k] has addresses[k] (the record as it was when the snapshot was taken), and storage[k] says
+  // whether its buffer was bound then.
   std::vector<std::shared_ptr<const AccelerationStructureState>> structures;
+  std::vector<StructureStorage> storage;
+  bool all_bound = true;  // every storage[k] is kBound
   // Every live structure's address is known (the layer could ask for them all): otherwise an address not found
   // may belong to a structure whose address the layer does not know, and nothing is concluded from its absence.
   bool complete = true;
@@ -38,10 +46,15 @@ class LiveStructureAddressCache {
  public:
   using StructureMap = ConcurrentMap<VkAccelerationStructureKHR, std::shared_ptr<const AccelerationStructureState>>;
 
-  std::shared_ptr<const LiveStructureAddresses> Get(const StructureMap& structures) const {
+  // The snapshot for now: the cached one while neither the structures nor the binding of any structure's storage
+  // changed (`storage_stamp`: DeviceState::structure_storage_changes), else a new one, each structure's storage
+  // judged by storage_of(const AccelerationStructureState&) -> StructureStorage.
+  template <typename StorageOf>
+  std::shared_ptr<const LiveStructureAddresses> Get(const StructureMap& structures, StampValue storage_stamp,
+                                                    StorageOf&& storage_of) const {
     std::lock_guard<std::mutex> lock(mutex_);
     const StampValue stamp = structures.stamp();
-    if (cached_ && stamp == stamp_) return cached_;
+    if (cached_ && stamp == stamp_ && storage_stamp == storage_stamp_) return cached_;
     auto fresh = std::make_shared<LiveStructureAddresses>();
     std::vector<std::shared_ptr<const AccelerationStructureState>> live;
     for (auto& [handle, record] : structures.snapshot()) {
@@ -53,10 +66,16 @@ class LiveStructureAddressCache {
     }
     std::sort(live.begin(), live.end(), [](const auto& a, const auto& b) { return a->device_address < b->device_address; });
     fresh->addresses.reserve(live.size());
-    for (const auto& record : live) fresh->addresses.push_back(record->device_address);
+    fresh->storage.reserve(live.size());
+    for (const auto& record : live) {
+      fresh->addresses.push_back(record->device_address);
+      fresh->storage.push_back(storage_of(*record));
+      fresh->all_bound &= fresh->storage.back() == StructureStorage::kBound;
+    }
     fresh->structures = std::move(live);
     cached_ = std::move(fresh);
     stamp_ = stamp;
+    storage_stamp_ = storage_stamp;
     return cached_;
   }
 
@@ -64,6 +83,7 @@ class LiveStructureAddressCache {
   mutable std::mutex mutex_;
   mutable std::shared_ptr<const LiveStructureAddresses> cached_;
   mutable StampValue stamp_{};
+  mutable StampValue storage_stamp_{};
 };
 
 }  // namespace asval

@@ -34,14 +34,17 @@ void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
   const auto bound = state.buffers.snapshot([memory](VkBuffer, const std::shared_ptr<const BufferState>& b) {
     return b && b->bound && b->memory == memory;
   });
+  bool storage = false;
   for (const auto& [handle, old] : bound) {
     if (old->device_address != 0) state.buffer_addresses.Erase(old->device_address, handle);
     auto record = std::make_shared<BufferState>(*old);
     record->memory = VK_NULL_HANDLE;
     record->memory_freed = true;
     record->device_address = 0;
+    storage |= (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
     state.buffers.insert_or_assign(handle, std::move(record));
   }
+  if (storage) state.structure_storage_changes.Bump();
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
   state.history.store.ForgetMemory(memory);
 }
@@ -66,6 +69,9 @@ void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer) {
   if (record && *record && (*record)->device_address != 0) {
     state.buffer_addresses.Erase((*record)->device_address, buffer);
   }
+  if (record && *record && ((*record)->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR)) {
+    state.structure_storage_changes.Bump();
+  }
 }
 
 void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device, VkBuffer buffer,
@@ -83,7 +89,9 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
   if (record->device_address != 0) {
     state.buffer_addresses.Insert(record->device_address, record->size, buffer);
   }
+  const bool storage = (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
   state.buffers.insert_or_assign(buffer, std::move(record));
+  if (storage) state.structure_storage_changes.Bump();
 }
 
 void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device,
