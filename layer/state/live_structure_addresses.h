@@ -34,10 +34,35 @@ struct LiveStructureAddresses {
   // Every live structure's address is known (the layer could ask for them all): otherwise an address not found
   // may belong to a structure whose address the layer does not know, and nothing is concluded from its absence.
   bool complete = true;
+  // An open-addressing table over `addresses` (index + 1 per slot, 0 empty; at most half full): a top-level
+  // build's thousands of instances each cost a hash and a probe or two, not a binary search.
+  std::vector<uint32_t> slots;
+  uint32_t shift = 64;
+
+  static uint64_t Hash(VkDeviceAddress address) { return address * 0x9e3779b97f4a7c15ull; }
+  void Index() {
+    std::size_t size = 16;
+    while (size < 2 * addresses.size()) size *= 2;
+    slots.assign(size, 0);
+    shift = 64;
+    for (std::size_t s = size; s > 1; s >>= 1) --shift;
+    for (std::size_t k = 0; k < addresses.size(); ++k) {
+      std::size_t slot = Hash(addresses[k]) >> shift;
+      while (slots[slot] != 0) slot = (slot + 1) & (slots.size() - 1);
+      slots[slot] = static_cast<uint32_t>(k + 1);
+    }
+  }
   // The index of the structure with this address, or -1.
   std::ptrdiff_t Find(VkDeviceAddress address) const {
-    const auto it = std::lower_bound(addresses.begin(), addresses.end(), address);
-    return it != addresses.end() && *it == address ? it - addresses.begin() : -1;
+    if (slots.empty()) {  // not indexed (built by hand): the sorted addresses
+      const auto it = std::lower_bound(addresses.begin(), addresses.end(), address);
+      return it != addresses.end() && *it == address ? it - addresses.begin() : -1;
+    }
+    for (std::size_t slot = Hash(address) >> shift;; slot = (slot + 1) & (slots.size() - 1)) {
+      const uint32_t k = slots[slot];
+      if (k == 0) return -1;
+      if (addresses[k - 1] == address) return static_cast<std::ptrdiff_t>(k - 1);
+    }
   }
   bool Contains(VkDeviceAddress address) const { return Find(address) >= 0; }
 };
@@ -73,6 +98,7 @@ class LiveStructureAddressCache {
       fresh->all_bound &= fresh->storage.back() == StructureStorage::kBound;
     }
     fresh->structures = std::move(live);
+    fresh->Index();
     cached_ = std::move(fresh);
     stamp_ = stamp;
     storage_stamp_ = storage_stamp;
