@@ -19,7 +19,7 @@ while IFS= read -r name; do
 done < /tmp/names.txt
 echo "capture valid tests: passed $pass failed $fail"
 for round in 1 2 3 4 5; do for mode in none off updates all; do
-  if [ $mode = none ]; then r=$(timeout 120 .devrun/asval_scene --frames 200 2>&1 | grep -E "refits|validation messages" | tr '\n' ' ');
-  else r=$(VK_ADD_LAYER_PATH=$PWD/.devrun/layer VK_INSTANCE_LAYERS=VK_LAYER_ASVAL_as_validation VK_ASVAL_AS_VALIDATION_CAPTURE=$mode VK_ASVAL_AS_VALIDATION_REPORT_FLAGS=error,warn,info timeout 120 .devrun/asval_scene --frames 200 2>&1 | grep -E "refits|validation messages|Execution-time" | tr '\n' ' '); fi
+  if [ $mode = none ]; then r=$(timeout 120 .devrun/asval_scene --frames 300 2>&1 | grep -E "refits|validation messages" | tr '\n' ' ');
+  else r=$(VK_ADD_LAYER_PATH=$PWD/.devrun/layer VK_INSTANCE_LAYERS=VK_LAYER_ASVAL_as_validation VK_ASVAL_AS_VALIDATION_CAPTURE=$mode VK_ASVAL_AS_VALIDATION_REPORT_FLAGS=error,warn,info timeout 120 .devrun/asval_scene --frames 300 2>&1 | grep -E "refits|validation messages|Execution-time" | tr '\n' ' '); fi
   echo "$round $mode: $r"
 done; done
