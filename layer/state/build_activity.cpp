@@ -11,6 +11,38 @@ namespace asval {
 
 namespace {
 
+// The builder's views of a captured triangle or AABB geometry: the captured bytes with the parameters the copy
+// left to apply. A triangle view carries the captured transform too (only the box scan reads it; classifying
+// needs none: a transform does not change activity).
+builder::TriangleGeometryView TriangleView(const CaptureLog& log, const CapturedGeometry& g) {
+  builder::TriangleGeometryView view;
+  view.vertexData = log.Bytes(g.data);
+  view.vertexDataBytes = g.data.size;
+  view.vertexFormat = g.vertex_format;
+  view.vertexStride = g.vertex_stride;
+  view.maxVertex = g.max_vertex;
+  view.indexType = g.index_type;
+  if (g.indices.present) {
+    view.indexData = log.Bytes(g.indices);
+    view.indexDataBytes = g.indices.size;
+  }
+  if (g.transform.present) {
+    view.transformData = log.Bytes(g.transform);
+    view.transformDataBytes = g.transform.size;
+  }
+  view.range = g.range;
+  return view;
+}
+
+builder::AabbGeometryView AabbView(const CaptureLog& log, const CapturedGeometry& g) {
+  builder::AabbGeometryView view;
+  view.data = log.Bytes(g.data);
+  view.dataBytes = g.data.size;
+  view.stride = g.aabb_stride;
+  view.range = g.range;
+  return view;
+}
+
 // The builder's view of one captured geometry; false when its bytes were not captured.
 bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
               builder::ClassifyResult* out) {
@@ -22,19 +54,7 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   builder::ClassifyResult result;
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     if (g.index_type != VK_INDEX_TYPE_NONE_KHR && !g.indices.present) return false;
-    builder::TriangleGeometryView view;
-    view.vertexData = log.Bytes(g.data);
-    view.vertexDataBytes = g.data.size;
-    view.vertexFormat = g.vertex_format;
-    view.vertexStride = g.vertex_stride;
-    view.maxVertex = g.max_vertex;
-    view.indexType = g.index_type;
-    if (g.indices.present) {
-      view.indexData = log.Bytes(g.indices);
-      view.indexDataBytes = g.indices.size;
-    }
-    view.range = g.range;
-    result = builder::ClassifyTriangles(view, record, nullptr);
+    result = builder::ClassifyTriangles(TriangleView(log, g), record, nullptr);
   } else if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
     if (g.array_of_pointers) return false;  // the pointers only: the records they point to are not captured
     builder::InstanceGeometryView view;
@@ -43,12 +63,7 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
     view.range = g.range;
     result = builder::ClassifyInstances(view, record, nullptr);
   } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
-    builder::AabbGeometryView view;
-    view.data = log.Bytes(g.data);
-    view.dataBytes = g.data.size;
-    view.stride = g.aabb_stride;
-    view.range = g.range;
-    result = builder::ClassifyAabbs(view, record, nullptr);
+    result = builder::ClassifyAabbs(AabbView(log, g), record, nullptr);
   } else {
     return false;
   }
@@ -63,32 +78,11 @@ bool PrimitiveBoxes(const CaptureLog& log, const CapturedGeometry& g, builder::B
   if (g.range.primitiveCount == 0 || !g.data.present) return false;
   constexpr bool kKeepDegenerate = true;  // kept, and skipped below by their zero size
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
-    builder::TriangleGeometryView view;
-    view.vertexData = log.Bytes(g.data);
-    view.vertexDataBytes = g.data.size;
-    view.vertexFormat = g.vertex_format;
-    view.vertexStride = g.vertex_stride;
-    view.maxVertex = g.max_vertex;
-    view.indexType = g.index_type;
-    if (g.indices.present) {
-      view.indexData = log.Bytes(g.indices);
-      view.indexDataBytes = g.indices.size;
-    }
-    if (g.transform.present) {
-      view.transformData = log.Bytes(g.transform);
-      view.transformDataBytes = g.transform.size;
-    }
-    view.range = g.range;
-    builder::AppendTriangles(view, kKeepDegenerate, 0, out);
+    builder::AppendTriangles(TriangleView(log, g), kKeepDegenerate, 0, out);
     return true;
   }
   if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
-    builder::AabbGeometryView view;
-    view.data = log.Bytes(g.data);
-    view.dataBytes = g.data.size;
-    view.stride = g.aabb_stride;
-    view.range = g.range;
-    builder::AppendAabbs(view, kKeepDegenerate, 0, out);
+    builder::AppendAabbs(AabbView(log, g), kKeepDegenerate, 0, out);
     return true;
   }
   return false;
