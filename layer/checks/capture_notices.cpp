@@ -135,9 +135,10 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
     uint32_t count = 0, first = 0;
     int element = -1;
     for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
-      // The transform is the record's first member.
-      const int e = FirstNonFiniteElement(bytes + k * sizeof(VkAccelerationStructureInstanceKHR));
-      if (e >= 0 && count++ == 0) first = k, element = e;
+      // The transform is the record's first member. All finite, nearly always: the inline test, then the element.
+      const uint8_t* transform = bytes + k * sizeof(VkAccelerationStructureInstanceKHR);
+      if (AllFinite(transform)) continue;
+      if (count++ == 0) first = k, element = FirstNonFiniteElement(transform);
     }
     if (count == 0) continue;
     ctx.reporter.Report(Severity::kWarning, kNonFiniteTransformId, loc,

@@ -118,16 +118,11 @@ bool SpacingExceeds(float magnitude, float size, uint32_t permille) {
 }
 
 int FirstNonFiniteElement(const uint8_t* matrix) {
-  // A float is NaN or infinite exactly when its exponent bits are all set. The twelve are tested without a branch
-  // first (a frame's instance transforms are all finite): one pass the compiler vectorizes.
-  constexpr uint32_t kExponent = 0x7f800000u;
-  uint32_t words[12];
-  std::memcpy(words, matrix, sizeof(words));
-  uint32_t any = 0;
-  for (uint32_t w : words) any |= static_cast<uint32_t>((w & kExponent) == kExponent);
-  if (any == 0) return -1;
+  if (AllFinite(matrix)) return -1;
   for (int k = 0; k < 12; ++k) {
-    if ((words[k] & kExponent) == kExponent) return k;
+    float value;
+    std::memcpy(&value, matrix + 4 * k, sizeof(value));
+    if (!std::isfinite(value)) return k;
   }
   return -1;
 }
