@@ -13,10 +13,6 @@ namespace asval {
 
 namespace {
 
-using Source = CaptureSource;
-constexpr auto Add = SaturatingAddBytes;
-constexpr auto Mul = SaturatingMulBytes;
-
 // The buffer a range can be copied from: bound, created copyable by the layer, holding the whole range.
 std::optional<AddressHit> CopyableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
   return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
@@ -120,8 +116,9 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
     entry.indirect = true;
     entry.geometry_count = n;
     entry.indirect_stride = strides[i];
-    const VkDeviceSize bytes = Add(Mul(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
-    const bool within_budget = Add(log.bytes_captured, bytes) <= ctx.budget_bytes;
+    const VkDeviceSize bytes =
+        SaturatingAddBytes(SaturatingMulBytes(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
+    const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
     if (!within_budget) ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
     const std::optional<AddressHit> hit =
         within_budget ? CopyableBuffer(ctx.state, addresses[i], bytes) : std::nullopt;
@@ -150,7 +147,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
   if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
   thread_local std::vector<Copy> copies;
-  thread_local std::vector<Source> sources;
+  thread_local std::vector<CaptureSource> sources;
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   thread_local std::vector<CommandDestination> destinations;
   copies.clear();
@@ -187,13 +184,13 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
       entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources);
     }
     VkDeviceSize total = 0;
-    for (const Source& s : sources) total = Add(total, s.size);
-    if (entry.complete && Add(log.bytes_captured, total) > ctx.budget_bytes) {
+    for (const CaptureSource& s : sources) total = SaturatingAddBytes(total, s.size);
+    if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
       entry.complete = false;
       ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
     }
     const std::size_t first_copy = copies.size();
-    for (const Source& s : sources) {
+    for (const CaptureSource& s : sources) {
       if (!entry.complete) break;
       const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
       if (!hit && s.optional) continue;
@@ -201,7 +198,8 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
         entry.complete = false;
         break;
       }
-      copies.push_back(Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
+      copies.push_back(
+          Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
     }
     if (!entry.complete) {
       copies.resize(first_copy);

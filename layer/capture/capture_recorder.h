@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "capture_plan.h"
 #include "capture_pool.h"
 #include "device_state.h"
 #include "layer_settings.h"
@@ -37,8 +38,7 @@ inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeo
   // Top level: every build (its instance references are checked), and its updates (instance activity).
   if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) return true;
   if (info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return false;
-  return mode == kCaptureAll || info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
-         (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
+  return mode == kCaptureAll || ActivityNeededForUpdates(info);
 }
 
 // vkCmdBuildAccelerationStructuresKHR: records the captures of the infos that need them into cb (whose state

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "activity_rules.h"
+#include "history_apply.h"
 #include "history_findings.h"
 #include "history_recorder.h"
 #include "update_rules.h"
@@ -19,17 +20,9 @@ namespace {
 // holds it now (the host build runs now): compared outside the store's lock, since it reports.
 void CollectActivityComparison(const HistoryStore& store, const AsOp& op, std::vector<ActivityComparison>& out) {
   if (!op.is_update() || !op.capture_log) return;
-  ActivityComparison comparison;
-  if (const AsHistory* src = store.Find(op.src)) {
-    comparison.before = src->activity;
-    if (src->build) comparison.source_build = src->build->origin;
-  }
-  comparison.after = std::make_shared<BuildActivity>(op.capture_log->shared_from_this(), op.capture_info, op.origin,
-                                                     op.dst);
-  comparison.update = op.origin;
-  comparison.src = op.src;
-  comparison.dst = op.dst;
-  out.push_back(std::move(comparison));
+  out.push_back(ComparisonWithSource(
+      store, op,
+      std::make_shared<BuildActivity>(op.capture_log->shared_from_this(), op.capture_info, op.origin, op.dst)));
 }
 
 }  // namespace

@@ -67,11 +67,6 @@ std::string Referencing(const Referenced& r, const AccelerationStructureState& s
                      DescribeOrigin(c.build), Hex(c.dst), Referencing(r, s), Hex(s.buffer), why));
 }
 
-bool StillTheSame(const DeviceState& state, const AccelerationStructureState& s) {
-  std::optional<std::shared_ptr<const AccelerationStructureState>> now = state.acceleration_structures.find(s.handle);
-  return now && *now && (*now)->device_address == s.device_address && (*now)->buffer_id == s.buffer_id;
-}
-
 // pInfos-03709: the buffer the referenced structure was created on was bound to memory when the build was
 // submitted (the snapshot of live structures says).
 uint32_t CheckStorage(const CheckContext& ctx, const InstanceReferenceCheck& c, const Referenced& r,
@@ -141,9 +136,12 @@ uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& 
   // The structure's memory now (it cannot move while the build is pending); whole: which of its bytes the build
   // reads is the driver's business. Unknown when it was destroyed since, or its storage is not bound.
   std::optional<MemorySpan> span;
-  if (live.storage[k] == StructureStorage::kBound && StillTheSame(ctx.state, *structure)) {
-    if (std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, *structure)) {
-      span = StructureMemory{structure, std::move(buffer)}.Span();
+  if (live.storage[k] == StructureStorage::kBound) {
+    const std::optional<StructureMemory> now = MemoryOfStructure(ctx.state, structure->handle);
+    // Still the structure the snapshot saw (its handle value may name a newer one).
+    if (now && now->structure->device_address == structure->device_address &&
+        now->structure->buffer_id == structure->buffer_id) {
+      span = now->Span();
     }
   }
   return findings + CheckAgainstDestinations(ctx, c, log, info, r, *structure, span);

@@ -9,12 +9,13 @@ namespace {
 
 constexpr VkDeviceSize kAabbBytes = sizeof(VkAabbPositionsKHR);                      // 24
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
-constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);                 // 48
+constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);               // 48
 
 }  // namespace
 
-bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerationStructureBuildRangeInfoKHR& r,
-                          bool host, CapturedGeometry* out, std::vector<CaptureSource>& sources) {
+bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
+                          const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
+                          std::vector<CaptureSource>& sources) {
   // Host builds give host pointers in the same unions: read the member the command uses.
   const auto address = [host](const VkDeviceOrHostAddressConstKHR& a) -> uint64_t {
     return host ? reinterpret_cast<uint64_t>(a.hostAddress) : a.deviceAddress;
@@ -33,13 +34,15 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkA
     if (n == 0) return true;
     if (address(t.vertexData) == 0) return false;
     if (address(t.transformData) != 0) {
-      sources.push_back(CaptureSource{SaturatingAddBytes(address(t.transformData), r.transformOffset), kTransformBytes, &out->transform,
-                               true});
+      sources.push_back(CaptureSource{SaturatingAddBytes(address(t.transformData), r.transformOffset), kTransformBytes,
+                                      &out->transform, true});
     }
     if (index_bytes == 0) {
       // Vertex k of the range is read at primitiveOffset + stride * (firstVertex + k); the last one for its size.
-      const VkDeviceSize first = SaturatingAddBytes(r.primitiveOffset, SaturatingMulBytes(t.vertexStride, r.firstVertex));
-      const VkDeviceSize bytes = SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, SaturatingMulBytes(3, n) - 1), format.vertexBytes);
+      const VkDeviceSize first =
+          SaturatingAddBytes(r.primitiveOffset, SaturatingMulBytes(t.vertexStride, r.firstVertex));
+      const VkDeviceSize bytes =
+          SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, SaturatingMulBytes(3, n) - 1), format.vertexBytes);
       out->max_vertex = t.maxVertex >= r.firstVertex ? t.maxVertex - r.firstVertex : 0;
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.vertexData), first), bytes, &out->data});
     } else {
@@ -47,10 +50,11 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkA
       // Indices from primitiveOffset; vertices index + firstVertex up to maxVertex, from vertexData.
       out->max_vertex = t.maxVertex;
       out->range.firstVertex = r.firstVertex;
-      sources.push_back(CaptureSource{SaturatingAddBytes(address(t.indexData), r.primitiveOffset), SaturatingMulBytes(SaturatingMulBytes(3, n), index_bytes),
-                               &out->indices});
-      sources.push_back(
-          CaptureSource{address(t.vertexData), SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, t.maxVertex), format.vertexBytes), &out->data});
+      sources.push_back(CaptureSource{SaturatingAddBytes(address(t.indexData), r.primitiveOffset),
+                                      SaturatingMulBytes(SaturatingMulBytes(3, n), index_bytes), &out->indices});
+      sources.push_back(CaptureSource{
+          address(t.vertexData),
+          SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, t.maxVertex), format.vertexBytes), &out->data});
     }
     return true;
   }
@@ -59,8 +63,8 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkA
     out->aabb_stride = a.stride;
     if (n == 0) return true;
     if (address(a.data) == 0) return false;
-    sources.push_back(
-        CaptureSource{SaturatingAddBytes(address(a.data), r.primitiveOffset), SaturatingAddBytes(SaturatingMulBytes(a.stride, n - 1), kAabbBytes), &out->data});
+    sources.push_back(CaptureSource{SaturatingAddBytes(address(a.data), r.primitiveOffset),
+                                    SaturatingAddBytes(SaturatingMulBytes(a.stride, n - 1), kAabbBytes), &out->data});
     return true;
   }
   if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
@@ -71,7 +75,8 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkA
     if (n == 0) return true;
     if (address(in.data) == 0) return false;
     const VkDeviceSize record_bytes = out->array_of_pointers ? sizeof(VkDeviceAddress) : kInstanceBytes;
-    sources.push_back(CaptureSource{SaturatingAddBytes(address(in.data), r.primitiveOffset), SaturatingMulBytes(record_bytes, n), &out->data});
+    sources.push_back(CaptureSource{SaturatingAddBytes(address(in.data), r.primitiveOffset),
+                                    SaturatingMulBytes(record_bytes, n), &out->data});
     return true;
   }
   return false;

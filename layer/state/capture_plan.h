@@ -21,6 +21,13 @@ inline VkDeviceSize SaturatingMulBytes(VkDeviceSize a, VkDeviceSize b) {
   return b != 0 && a > kNoBytes / b ? kNoBytes : a * b;
 }
 
+// Whether an info's activity is what an update rule compares: it is an update, or the source a later update may
+// have (ALLOW_UPDATE).
+inline bool ActivityNeededForUpdates(const VkAccelerationStructureBuildGeometryInfoKHR& info) {
+  return info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
+         (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
+}
+
 // One range a build reads: from an address (a device address, or a host pointer for host builds) into the
 // capture log.
 struct CaptureSource {
@@ -33,7 +40,8 @@ struct CaptureSource {
 // The ranges geometry g reads into `sources` (appended), its captured parameters into *out. `host`: the
 // geometry's addresses are host pointers (vkBuildAccelerationStructuresKHR). False when the geometry is not
 // captured (a kind or format the builder does not read, a null address with primitives to read).
-bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g, const VkAccelerationStructureBuildRangeInfoKHR& r,
-                          bool host, CapturedGeometry* out, std::vector<CaptureSource>& sources);
+bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
+                          const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
+                          std::vector<CaptureSource>& sources);
 
 }  // namespace asval

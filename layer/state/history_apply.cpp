@@ -121,17 +121,6 @@ IndirectRangeCheck IndirectCheck(const HistoryStore& store, const AsOp& op, Capt
   return check;
 }
 
-// Whether a live structure's storage is bound now (pInfos-03709), for the snapshot of live structures.
-StructureStorage StorageOfStructure(const DeviceState& state, const AccelerationStructureState& structure) {
-  if (structure.buffer_id == 0) return StructureStorage::kUnknown;  // created on a buffer the layer never saw
-  const std::shared_ptr<const BufferState> buffer = BufferOfStructure(state, structure);
-  if (!buffer) return StructureStorage::kBufferDestroyed;
-  // Sparse buffers are bound by vkQueueBindSparse, which the layer does not follow.
-  if (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return StructureStorage::kUnknown;
-  if (buffer->bound && buffer->memory != VK_NULL_HANDLE) return StructureStorage::kBound;
-  return buffer->memory_freed ? StructureStorage::kMemoryFreed : StructureStorage::kUnbound;
-}
-
 // A captured build's activity, filled when its submission completes; an update's comparison with its source's.
 // The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
 // one call) holds the bytes of the last execution only: both are unknown.
@@ -172,17 +161,7 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     check.dst = op.dst;
     captures.instance_checks.push_back(std::move(check));
   }
-  if (op.is_update()) {
-    const AsHistory* src = store.Find(op.src);
-    ActivityComparison comparison;
-    comparison.before = src ? src->activity : nullptr;
-    if (src && src->build) comparison.source_build = src->build->origin;
-    comparison.after = node;
-    comparison.update = op.origin;
-    comparison.src = op.src;
-    comparison.dst = op.dst;
-    captures.comparisons.push_back(std::move(comparison));
-  }
+  if (op.is_update()) captures.comparisons.push_back(ComparisonWithSource(store, op, node));
   return node;
 }
 
@@ -398,6 +377,20 @@ void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as,
   h.serialization_size = size;
   h.serialization_size_generation = generation;
   store.Set(as, std::move(h), nullptr);
+}
+
+ActivityComparison ComparisonWithSource(const HistoryStore& store, const AsOp& op,
+                                        std::shared_ptr<BuildActivity> after) {
+  ActivityComparison comparison;
+  if (const AsHistory* src = store.Find(op.src)) {
+    comparison.before = src->activity;
+    if (src->build) comparison.source_build = src->build->origin;
+  }
+  comparison.after = std::move(after);
+  comparison.update = op.origin;
+  comparison.src = op.src;
+  comparison.dst = op.dst;
+  return comparison;
 }
 
 bool RestoreDeserializedHistory(HistoryStore& store, const DeserializeCheck& check) {

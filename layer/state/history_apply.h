@@ -35,6 +35,11 @@ void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as,
 // the restore is not undone.
 bool RestoreDeserializedHistory(HistoryStore& store, const DeserializeCheck& check);
 
+// An update (op) paired with its source's activity as the history holds it now (the build that last executed on
+// it), to be compared with the update's own activity `after` (pInfos-03663, 03664, 03768). Store's lock held.
+ActivityComparison ComparisonWithSource(const HistoryStore& store, const AsOp& op,
+                                        std::shared_ptr<BuildActivity> after);
+
 // Where serialized bytes end: the header's total size (bytes 32..39, VK_UUID_SIZE * 2 in) of host data.
 uint64_t SerializedHostSize(const void* data);
 

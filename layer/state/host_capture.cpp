@@ -23,11 +23,6 @@ class HeapSlabOwner final : public CaptureSlabOwner {
   void Return(const CaptureSlab& slab) override { delete[] slab.mapped; }
 };
 
-bool Captured(const VkAccelerationStructureBuildGeometryInfoKHR& info) {
-  return info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ||
-         (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR) != 0;
-}
-
 }  // namespace
 
 HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
@@ -39,7 +34,7 @@ HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStru
   std::vector<CapturedGeometry> planned;
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
-    if (!Captured(info)) continue;
+    if (!ActivityNeededForUpdates(info)) continue;
     if (!capture.log) {
       capture.log = std::make_shared<CaptureLog>(std::make_shared<HeapSlabOwner>());
       capture.captured.assign(info_count, 0);

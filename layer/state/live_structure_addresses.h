@@ -64,7 +64,6 @@ struct LiveStructureAddresses {
       if (addresses[k - 1] == address) return static_cast<std::ptrdiff_t>(k - 1);
     }
   }
-  bool Contains(VkDeviceAddress address) const { return Find(address) >= 0; }
 };
 
 class LiveStructureAddressCache {
@@ -89,7 +88,8 @@ class LiveStructureAddressCache {
       }
       live.push_back(std::move(record));
     }
-    std::sort(live.begin(), live.end(), [](const auto& a, const auto& b) { return a->device_address < b->device_address; });
+    std::sort(live.begin(), live.end(),
+              [](const auto& a, const auto& b) { return a->device_address < b->device_address; });
     fresh->addresses.reserve(live.size());
     fresh->storage.reserve(live.size());
     for (const auto& record : live) {

@@ -40,6 +40,18 @@ inline std::shared_ptr<const BufferState> BufferOfStructure(const DeviceState& s
   return std::move(*buffer);
 }
 
+// Whether a structure's storage is bound now (pInfos-03709; the snapshot of live structures keeps it).
+inline StructureStorage StorageOfStructure(const DeviceState& state, const AccelerationStructureState& structure) {
+  if (structure.buffer_id == 0) return StructureStorage::kUnknown;  // created on a buffer the layer never saw
+  std::shared_ptr<const BufferState> buffer = BufferOfStructure(state, structure);
+  if (!buffer) return StructureStorage::kBufferDestroyed;
+  // Sparse buffers are bound by vkQueueBindSparse, which the layer does not follow.
+  if (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return StructureStorage::kUnknown;
+  const bool freed = buffer->memory_freed;
+  if (StructureMemory{nullptr, std::move(buffer)}.bound()) return StructureStorage::kBound;
+  return freed ? StructureStorage::kMemoryFreed : StructureStorage::kUnbound;
+}
+
 // nullopt when the structure or its buffer is not known to the layer.
 inline std::optional<StructureMemory> MemoryOfStructure(const DeviceState& state, VkAccelerationStructureKHR handle) {
   if (handle == VK_NULL_HANDLE) return std::nullopt;
