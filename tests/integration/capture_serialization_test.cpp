@@ -5,14 +5,13 @@
 // processed, and whenever the bytes differ, the history stays unknown: the update rules are skipped and counted,
 // never guessed. Without the capture (before issue 12) every deserialization of device bytes left the history
 // unknown, so the invalid updates below went unreported: the first two tests fail on that behaviour.
-#include <unistd.h>
 
 #include <catch2/catch_test_macros.hpp>
 #include <cstdio>
-#include <fstream>
 
 #include "capture_helpers.h"
 #include "history_helpers.h"
+#include "temp_report.h"
 
 namespace asval_test {
 namespace {
@@ -37,19 +36,6 @@ Shape TwoTriangles() {
 // usage to such buffers (no usage names a serialization buffer), so it copies only from buffers the app made
 // copyable.
 constexpr VkBufferUsageFlags kBlobUsage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
-std::string TempPath() {
-  char path[] = "/tmp/asval-serialization-XXXXXX";
-  const int fd = mkstemp(path);
-  REQUIRE(fd >= 0);
-  close(fd);
-  return path;
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // The serialized bytes written (a serialization, a fill or a copy into them) made visible to a deserialization.
 void BlobWritten(VkCommandBuffer cb) {
@@ -179,14 +165,14 @@ TEST_CASE("capture valid twin: updates of a structure deserialized from device b
 
 // The summary vkDestroyDevice writes, after `scenario` ran on a fresh device.
 std::string Summary(const std::function<void(HistoryFixture&)>& scenario) {
-  const std::string report = TempPath();
+  asval_test_common::TempReport report;
   {
-    HistoryFixture f("history", {{"report_file", report.c_str()}, {"report_flags", "error,warn,info"}});
+    HistoryFixture f("history", {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"}});
     scenario(f);
     f.Close();
   }
-  std::string json = ReadAll(report);
-  std::remove(report.c_str());
+  std::string json;
+  for (const std::string& line : report.Lines()) json += line + "\n";
   return json;
 }
 
