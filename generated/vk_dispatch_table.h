@@ -31,12 +31,14 @@ struct DeviceDispatchTable {
   PFN_vkBindBufferMemory BindBufferMemory = nullptr;
   PFN_vkBindBufferMemory2 BindBufferMemory2 = nullptr;
   PFN_vkBuildAccelerationStructuresKHR BuildAccelerationStructuresKHR = nullptr;
+  PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR CmdBuildAccelerationStructuresIndirectKHR = nullptr;
   PFN_vkCmdBuildAccelerationStructuresKHR CmdBuildAccelerationStructuresKHR = nullptr;
   PFN_vkCmdCopyAccelerationStructureKHR CmdCopyAccelerationStructureKHR = nullptr;
   PFN_vkCmdCopyAccelerationStructureToMemoryKHR CmdCopyAccelerationStructureToMemoryKHR = nullptr;
   PFN_vkCmdCopyBuffer CmdCopyBuffer = nullptr;
   PFN_vkCmdCopyMemoryToAccelerationStructureKHR CmdCopyMemoryToAccelerationStructureKHR = nullptr;
+  PFN_vkCmdDispatchBase CmdDispatchBase = nullptr;
   PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
   PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
   PFN_vkCmdWriteAccelerationStructuresPropertiesKHR CmdWriteAccelerationStructuresPropertiesKHR = nullptr;
@@ -46,8 +48,11 @@ struct DeviceDispatchTable {
   PFN_vkCreateAccelerationStructureKHR CreateAccelerationStructureKHR = nullptr;
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
+  PFN_vkCreateComputePipelines CreateComputePipelines = nullptr;
   PFN_vkCreateFence CreateFence = nullptr;
+  PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
+  PFN_vkCreateShaderModule CreateShaderModule = nullptr;
   PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
   PFN_vkDestroyAccelerationStructureKHR DestroyAccelerationStructureKHR = nullptr;
   PFN_vkDestroyBuffer DestroyBuffer = nullptr;
@@ -55,7 +60,10 @@ struct DeviceDispatchTable {
   PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
   PFN_vkDestroyDevice DestroyDevice = nullptr;
   PFN_vkDestroyFence DestroyFence = nullptr;
+  PFN_vkDestroyPipeline DestroyPipeline = nullptr;
+  PFN_vkDestroyPipelineLayout DestroyPipelineLayout = nullptr;
   PFN_vkDestroyQueryPool DestroyQueryPool = nullptr;
+  PFN_vkDestroyShaderModule DestroyShaderModule = nullptr;
   PFN_vkDeviceWaitIdle DeviceWaitIdle = nullptr;
   PFN_vkEndCommandBuffer EndCommandBuffer = nullptr;
   PFN_vkFreeCommandBuffers FreeCommandBuffers = nullptr;

@@ -13,6 +13,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkBindBufferMemory2",
     "vkBindBufferMemory2KHR",
     "vkBuildAccelerationStructuresKHR",
+    "vkCmdBindPipeline",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
     "vkCmdBuildAccelerationStructuresKHR",
     "vkCmdCopyAccelerationStructureKHR",
@@ -73,6 +74,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkBindBufferMemory2
     true,  // vkBindBufferMemory2KHR
     true,  // vkBuildAccelerationStructuresKHR
+    true,  // vkCmdBindPipeline
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
     true,  // vkCmdBuildAccelerationStructuresKHR
     true,  // vkCmdCopyAccelerationStructureKHR

@@ -17,6 +17,7 @@ const InterceptEntry kIntercepts[] = {
     {"vkBindBufferMemory2", reinterpret_cast<PFN_vkVoidFunction>(&BindBufferMemory2), true},
     {"vkBindBufferMemory2KHR", reinterpret_cast<PFN_vkVoidFunction>(&BindBufferMemory2), true},
     {"vkBuildAccelerationStructuresKHR", reinterpret_cast<PFN_vkVoidFunction>(&BuildAccelerationStructuresKHR), true},
+    {"vkCmdBindPipeline", reinterpret_cast<PFN_vkVoidFunction>(&CmdBindPipeline), true},
     {"vkCmdBuildAccelerationStructuresIndirectKHR", reinterpret_cast<PFN_vkVoidFunction>(&CmdBuildAccelerationStructuresIndirectKHR), true},
     {"vkCmdBuildAccelerationStructuresKHR", reinterpret_cast<PFN_vkVoidFunction>(&CmdBuildAccelerationStructuresKHR), true},
     {"vkCmdCopyAccelerationStructureKHR", reinterpret_cast<PFN_vkVoidFunction>(&CmdCopyAccelerationStructureKHR), true},

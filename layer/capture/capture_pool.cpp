@@ -22,8 +22,8 @@ uint32_t PickMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t
 }  // namespace
 
 CapturePool::CapturePool(VkDevice device, const DeviceDispatchTable& next,
-                         const VkPhysicalDeviceMemoryProperties& memory)
-    : device_(device), next_(next) {
+                         const VkPhysicalDeviceMemoryProperties& memory, std::unique_ptr<CaptureReducer> reducer)
+    : device_(device), next_(next), reducer_(std::move(reducer)), reduces_(reducer_ != nullptr) {
   memory_type_ = PickMemoryType(memory, ~0u);
 }
 
@@ -33,7 +33,7 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
   if (memory_type_ == UINT32_MAX || !next_.CreateBuffer || !next_.AllocateMemory || !next_.MapMemory) return false;
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = bytes;
-  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | (reducer_ ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   CaptureSlab s;
   s.size = bytes;
@@ -43,6 +43,9 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = requirements.size;
   allocate.memoryTypeIndex = memory_type_;
+  VkMemoryAllocateFlagsInfo address_flag{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+  address_flag.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+  if (reducer_) allocate.pNext = &address_flag;
   void* mapped = nullptr;
   if (!(requirements.memoryTypeBits & (1u << memory_type_)) ||
       next_.AllocateMemory(device_, &allocate, nullptr, &s.memory) != VK_SUCCESS) {
@@ -55,12 +58,20 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
     next_.FreeMemory(device_, s.memory, nullptr);
     return false;
   }
-  s.mapped = static_cast<const uint8_t*>(mapped);
+  s.mapped = static_cast<uint8_t*>(mapped);
+  if (reducer_) {
+    // No pipeline (its creation failed): this slab's captures are copied.
+    VkBufferDeviceAddressInfo address{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    address.buffer = s.buffer;
+    s.address = next_.GetBufferDeviceAddress(device_, &address);
+    if (s.address != 0) s.reduce_pipeline = reducer_->MakePipeline(s.address);
+  }
   *slab = s;
   return true;
 }
 
 void CapturePool::Destroy(const CaptureSlab& slab) {
+  if (reducer_) reducer_->DestroyPipeline(slab.reduce_pipeline);
   next_.DestroyBuffer(device_, slab.buffer, nullptr);
   next_.FreeMemory(device_, slab.memory, nullptr);  // unmaps
 }
@@ -98,6 +109,7 @@ void CapturePool::Shutdown() {
   for (const CaptureSlab& slab : all_) Destroy(slab);
   all_.clear();
   free_.clear();
+  reducer_.reset();  // its module and layout, before the device goes
 }
 
 }  // namespace asval

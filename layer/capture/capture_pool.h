@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "capture_log.h"
+#include "capture_reducer.h"
 #include "vk_dispatch_table.h"
 
 namespace asval {
@@ -19,7 +20,10 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   // Slabs are at least this large (a slab serves many captures of one recording).
   static constexpr VkDeviceSize kSlabBytes = VkDeviceSize{4} << 20;
 
-  CapturePool(VkDevice device, const DeviceDispatchTable& next, const VkPhysicalDeviceMemoryProperties& memory);
+  // `reducer` (may be null): the capture reduces on the device (capture_method); every slab then gets a device
+  // address and the reducer's pipeline for it.
+  CapturePool(VkDevice device, const DeviceDispatchTable& next, const VkPhysicalDeviceMemoryProperties& memory,
+              std::unique_ptr<CaptureReducer> reducer = nullptr);
   ~CapturePool() override;
 
   // A slab of at least `bytes`; nullopt when the device cannot give one (no host-visible coherent memory type,
@@ -28,6 +32,8 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   void Return(const CaptureSlab& slab) override;
   // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
   void Shutdown();
+  // The capture reduces on the device (slabs have a pipeline each).
+  bool reduces() const { return reduces_; }
 
  private:
   bool Create(VkDeviceSize bytes, CaptureSlab* slab);
@@ -35,6 +41,8 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
 
   const VkDevice device_;
   const DeviceDispatchTable& next_;
+  std::unique_ptr<CaptureReducer> reducer_;  // until Shutdown
+  const bool reduces_;
   uint32_t memory_type_ = UINT32_MAX;  // HOST_VISIBLE | HOST_COHERENT, HOST_CACHED preferred (the host reads)
   std::mutex mutex_;
   std::vector<CaptureSlab> free_;

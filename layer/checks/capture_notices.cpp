@@ -116,7 +116,7 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present || g.array_of_pointers) continue;
     const uint8_t* bytes = log->Bytes(g.data);
-    if (spacing_permille != 0) {
+    if (spacing_permille != 0 && !g.reduced) {  // (never reduced: the capture copies when float_spacing is on)
       const FarInstances far = FindFarInstances(build, bytes, g.range.primitiveCount, spacing_permille);
       if (far.count != 0) {
         ctx.reporter.Report(
@@ -134,7 +134,20 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
     if (!(warnings & kCaptureWarnNonFiniteTransform)) continue;
     uint32_t count = 0, first = 0;
     int element = -1;
-    for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
+    if (g.reduced) {  // no records here: the dispatch's bits, and its first element per 32 records
+      const ReducedGeometry reduced = log->Reduced(g);
+      for (uint32_t w = 0; w < ReducedWords(reduced.count); ++w) {
+        const uint32_t bits = reduced.InstanceWord(0, w);
+        if (bits == 0) continue;
+        if (count == 0) {
+          const uint32_t lane_element = reduced.InstanceWord(1, w);
+          first = 32 * w + (lane_element >> 4);
+          element = static_cast<int>(lane_element & 15u);
+        }
+        count += static_cast<uint32_t>(__builtin_popcount(bits));
+      }
+    }
+    for (uint32_t k = 0; k < g.range.primitiveCount && !g.reduced; ++k) {
       // The transform is the record's first member. All finite, nearly always: the inline test, then the element.
       const uint8_t* transform = bytes + k * sizeof(VkAccelerationStructureInstanceKHR);
       if (AllFinite(transform)) continue;

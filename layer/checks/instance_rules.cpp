@@ -194,13 +194,15 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       if (ctx.Enabled(kCheckAlignment)) CheckInstancePointers(ctx, c, *log, j, g);
       continue;
     }
-    const uint8_t* bytes = log->Bytes(g.data);
+    // The records as copied, or the references alone as the layer's dispatch wrote them (CapturedGeometry::reduced).
+    const uint8_t* references = log->Bytes(g.data) + (g.reduced ? 0 : kReferenceOffset);
+    const VkDeviceSize stride = g.reduced ? sizeof(uint64_t) : kInstanceBytes;
     uint64_t bad = 0;
     bool unknown = false;
     std::string named;
     for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
       uint64_t reference = 0;
-      std::memcpy(&reference, bytes + k * kInstanceBytes + kReferenceOffset, sizeof(reference));
+      std::memcpy(&reference, references + k * stride, sizeof(reference));
       if (reference == 0) continue;  // an inactive instance
       const std::ptrdiff_t structure = live.Find(reference);
       if (structure >= 0) {

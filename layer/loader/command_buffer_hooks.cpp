@@ -77,4 +77,14 @@ VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uin
   RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);
 }
 
+VKAPI_ATTR void VKAPI_CALL CmdBindPipeline(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,
+                                           VkPipeline pipeline) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdBindPipeline(commandBuffer, pipelineBindPoint, pipeline);
+  // Only where the layer's reducing dispatch may replace it (capture_reducer.h): elsewhere a pass-through.
+  if (pipelineBindPoint == VK_PIPELINE_BIND_POINT_COMPUTE && data->capture_pool && data->capture_pool->reduces()) {
+    RecordBindComputePipeline(data->state, commandBuffer, pipeline);
+  }
+}
+
 }  // namespace asval::hooks

@@ -55,6 +55,14 @@ void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, D
   out->acceleration_structure.pNext = nullptr;
 }
 
+// Whether the app enabled a device extension.
+bool EnablesExtension(const VkDeviceCreateInfo& info, const char* name) {
+  for (uint32_t k = 0; k < info.enabledExtensionCount; ++k) {
+    if (info.ppEnabledExtensionNames[k] && std::strcmp(info.ppEnabledExtensionNames[k], name) == 0) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 namespace hooks {
@@ -143,7 +151,14 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   // Execution-time capture: needs the history (its records live there).
   if (data->state.history_tracked && instance->settings.capture != kCaptureOff) {
-    data->capture_pool = std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory);
+    std::unique_ptr<CaptureReducer> reducer;
+    if (CaptureReduces(settings.capture_method, data->state.properties.core.deviceType,
+                       data->state.features.buffer_device_address, EnablesExtension(*pCreateInfo, "VK_EXT_shader_object"),
+                       (settings.capture_warnings & kCaptureWarnFloatSpacing) != 0)) {
+      reducer = CaptureReducer::Create(*pDevice, data->dispatch);  // null: the capture copies
+    }
+    data->capture_pool =
+        std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, std::move(reducer));
     data->capture_tracker = std::make_unique<CaptureTracker>(*pDevice, data->dispatch);
   }
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));

@@ -6,6 +6,8 @@
 
 #include "asval/builder/build_input.h"
 #include "asval/builder/classify.h"
+#include "asval/builder/index_hash.h"
+#include "asval/builder/vertex_format.h"
 
 namespace asval {
 
@@ -43,6 +45,51 @@ builder::AabbGeometryView AabbView(const CaptureLog& log, const CapturedGeometry
   return view;
 }
 
+// The record of a geometry the layer's dispatch classified on the device (CapturedGeometry::reduced): its bits as
+// the builder would have set them, and the index hash from the copied indices, as the builder computes it. False
+// when a primitive could not be read (an index above maxVertex), as for the builder's unreadable primitives.
+bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
+                   builder::ClassifyResult* out) {
+  const ReducedGeometry reduced = log.Reduced(g);
+  const uint32_t n = reduced.count;
+  record->primitiveCount = n;
+  record->activeBits.assign((static_cast<std::size_t>(n) + 63) / 64, 0);
+  record->hasIndexHash = false;
+  record->indexHash = {};
+  builder::ClassifyResult result;
+  result.primitiveCount = n;
+  uint32_t active = 0;
+  if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {  // active iff the reference is not 0
+    for (uint32_t k = 0; k < n; ++k) {
+      if (reduced.Reference(k) == 0) continue;
+      record->activeBits[k >> 6] |= uint64_t{1} << (k & 63);
+      ++active;
+    }
+  } else {
+    for (uint32_t w = 0; w < ReducedWords(n); ++w) {
+      if (reduced.Word(2, w) != 0) return false;  // unreadable
+      const uint32_t bits = reduced.Word(0, w);
+      record->activeBits[w / 2] |= uint64_t{bits} << (32 * (w % 2));
+      active += static_cast<uint32_t>(__builtin_popcount(bits));
+      if (const uint32_t undefined = reduced.Word(1, w)) {
+        if (result.undefinedNaN == 0) result.firstUndefined = 32 * w + static_cast<uint32_t>(__builtin_ctz(undefined));
+        result.undefinedNaN += static_cast<uint32_t>(__builtin_popcount(undefined));
+      }
+    }
+    if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g.index_type != VK_INDEX_TYPE_NONE_KHR) {
+      if (!g.indices.present) return false;
+      record->hasIndexHash = true;
+      record->indexHash = builder::HashIndexBytes(log.Bytes(g.indices), static_cast<std::size_t>(g.indices.size),
+                                                  static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type)));
+    }
+  }
+  record->activeCount = active;
+  result.active = active;
+  result.inactive = n - active;
+  *out = result;
+  return true;
+}
+
 // The builder's view of one captured geometry; false when its bytes were not captured.
 bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
               builder::ClassifyResult* out) {
@@ -51,6 +98,7 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
     return true;
   }
   if (!g.data.present) return false;
+  if (g.reduced) return RecordReduced(log, g, record, out);
   builder::ClassifyResult result;
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     if (g.index_type != VK_INDEX_TYPE_NONE_KHR && !g.indices.present) return false;
@@ -75,7 +123,8 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
 // The builder's per-primitive boxes of one captured triangle or AABB geometry (exactly decoded, through the
 // geometry's transform when it was captured), into `out`; false for other geometries.
 bool PrimitiveBoxes(const CaptureLog& log, const CapturedGeometry& g, builder::BuildInput* out) {
-  if (g.range.primitiveCount == 0 || !g.data.present) return false;
+  // Reduced on the device: no coordinates here (the capture copies whenever float_spacing is on).
+  if (g.range.primitiveCount == 0 || !g.data.present || g.reduced) return false;
   constexpr bool kKeepDegenerate = true;  // kept, and skipped below by their zero size
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     builder::AppendTriangles(TriangleView(log, g), kKeepDegenerate, 0, out);

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -46,10 +47,14 @@ struct CaptureCounters {
 
 // One block of layer-owned memory that the device copies build inputs into and the host reads.
 struct CaptureSlab {
-  VkBuffer buffer = VK_NULL_HANDLE;  // TRANSFER_DST
+  VkBuffer buffer = VK_NULL_HANDLE;  // TRANSFER_DST (and SHADER_DEVICE_ADDRESS when the capture reduces)
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  const uint8_t* mapped = nullptr;  // host-visible, coherent, mapped for the slab's lifetime
+  uint8_t* mapped = nullptr;  // host-visible, coherent, mapped for the slab's lifetime
   VkDeviceSize size = 0;
+  // capture_method reduce (layer/capture/capture_reducer.h): the slab's device address, and the layer's compute
+  // pipeline that reads its jobs from this slab; null when the capture copies.
+  VkDeviceAddress address = 0;
+  VkPipeline reduce_pipeline = VK_NULL_HANDLE;
 };
 
 // Where slabs come from and go back to (layer/capture's pool; destroyed with the device).
@@ -90,6 +95,44 @@ struct CapturedGeometry {
   CapturedBytes data;         // vertices (triangles) or AABB records
   CapturedBytes indices;      // indexed triangles
   CapturedBytes transform;    // triangles with a transform: its 48 bytes (for the warnings only; optional)
+  // capture_method reduce: `data` holds what the layer's dispatch wrote instead of the bytes (ReducedGeometry);
+  // the indices and the transform are still copied.
+  bool reduced = false;
+};
+
+// What the layer's dispatch wrote for a reduced geometry of `count` primitives (layer/capture/shaders/
+// reduce_inputs.comp): bit arrays of one bit per primitive in 32-bit words (bit t % 32 of word t / 32, zero past
+// the count). Triangles and AABBs: active, undefined input, unreadable (an index naming a vertex above maxVertex,
+// not read). Instances: each record's accelerationStructureReference (8 bytes each), then the records whose
+// transform has a NaN or infinite element, then per 32 records the first such one's (lane << 4) | element.
+inline uint32_t ReducedWords(uint32_t count) { return (count + 31) / 32; }
+inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count) {
+  const VkDeviceSize words = ReducedWords(count);
+  return type == VK_GEOMETRY_TYPE_INSTANCES_KHR ? 8 * VkDeviceSize{count} + 2 * 4 * words : 3 * 4 * words;
+}
+struct ReducedGeometry {
+  const uint8_t* base;
+  uint32_t count;
+  // Word w of bit array a (triangles and AABBs: 0 active, 1 undefined input, 2 unreadable).
+  uint32_t Word(uint32_t array, uint32_t w) const {
+    uint32_t v;
+    std::memcpy(&v, base + 4 * (VkDeviceSize{array} * ReducedWords(count) + w), sizeof(v));
+    return v;
+  }
+  bool Bit(uint32_t array, uint32_t t) const { return (Word(array, t / 32) >> (t % 32)) & 1u; }
+  // Instances.
+  uint64_t Reference(uint32_t k) const {
+    uint64_t v;
+    std::memcpy(&v, base + 8 * VkDeviceSize{k}, sizeof(v));
+    return v;
+  }
+  // Word w of the instances' non-finite transform array (array 0), or of its first elements (array 1: per word,
+  // (lane << 4) | element of its first such instance).
+  uint32_t InstanceWord(uint32_t array, uint32_t w) const {
+    uint32_t v;
+    std::memcpy(&v, base + 8 * VkDeviceSize{count} + 4 * (VkDeviceSize{array} * ReducedWords(count) + w), sizeof(v));
+    return v;
+  }
 };
 
 // A destination of a build command that has a captured top-level info among several: what the rules about one
@@ -130,8 +173,14 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   CaptureLog& operator=(const CaptureLog&) = delete;
 
   const uint8_t* Bytes(const CapturedBytes& bytes) const { return slabs[bytes.slab].mapped + bytes.offset; }
+  ReducedGeometry Reduced(const CapturedGeometry& g) const { return ReducedGeometry{Bytes(g.data), g.range.primitiveCount}; }
   // The slab's buffer the device copies `bytes` into.
   VkBuffer BufferOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].buffer; }
+  // capture_method reduce: where the device writes `bytes`, and the pipeline that reads jobs from their slab.
+  VkDeviceAddress AddressOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].address + bytes.offset; }
+  VkPipeline ReducePipelineOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].reduce_pipeline; }
+  // The recording thread writes a reduce job's parameters (before any submission reads them).
+  uint8_t* WritableBytes(const CapturedBytes& bytes) { return slabs[bytes.slab].mapped + bytes.offset; }
 
   // ---- written by the recording thread (layer/capture's pre-record, through these) ----
   // Room for `size` bytes, 16-aligned, in the last slab or a new one; *where is set and marked present. False

@@ -10,6 +10,7 @@ void CommandBufferState::Reset() {
   secondaries.clear();
   capture_log.reset();  // a submission still reading it keeps it
   executed_capture_logs.clear();
+  compute_pipeline = VK_NULL_HANDLE;
   calls_.fill(0);
   std::shared_ptr<const RecordedOps> old;
   {

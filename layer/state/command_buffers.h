@@ -55,6 +55,10 @@ class CommandBufferState {
   // secondaries' recordings.
   std::shared_ptr<CaptureLog> capture_log;
   std::vector<std::shared_ptr<CaptureLog>> executed_capture_logs;
+  // The app's compute pipeline bound now (tracked only where the capture reduces on the device): bound again
+  // after the layer's reducing dispatch. Null: none bound yet in this recording, or the binding became undefined
+  // (vkCmdExecuteCommands).
+  VkPipeline compute_pipeline = VK_NULL_HANDLE;
   // The recording's capture log, made on its first capture with slabs from `owner`.
   CaptureLog& CaptureLogFor(const std::shared_ptr<CaptureSlabOwner>& owner) {
     if (!capture_log) capture_log = std::make_shared<CaptureLog>(owner);

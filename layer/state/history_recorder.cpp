@@ -165,10 +165,17 @@ void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t c
   });
 }
 
+void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipeline pipeline) {
+  if (CommandBufferState* recording = RecordingBuild(state, cb, ThisThreadsLastRecordedBuild())) {
+    recording->compute_pipeline = pipeline;
+  }
+}
+
 void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
                            const VkCommandBuffer* secondaries) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, primary);
   if (!recording || !secondaries) return;
+  recording->compute_pipeline = VK_NULL_HANDLE;  // the primary's bound state is undefined after the secondaries
   for (uint32_t i = 0; i < count; ++i) {
     Guarded(*recording, [&] { recording->secondaries.push_back(secondaries[i]); });
     const std::shared_ptr<CommandBufferState> secondary = state.command_buffers.Find(secondaries[i]);

@@ -39,6 +39,9 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
 void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
                               const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
                               uint32_t first_query);
+// vkCmdBindPipeline with VK_PIPELINE_BIND_POINT_COMPUTE, where the capture reduces on the device: the pipeline the
+// layer binds again after its dispatch (CommandBufferState::compute_pipeline).
+void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipeline pipeline);
 // vkCmdExecuteCommands: the secondaries' completed recordings join the primary's, in order.
 void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
                            const VkCommandBuffer* secondaries);

@@ -1,0 +1,159 @@
+#version 460
+// Execution-time capture, reduced on the device (issue 12, setting capture_method): instead of copying a build's
+// vertices, AABBs or instance records to the host, one dispatch per captured geometry reads them where the build
+// reads them and writes only what the rules need, as the reference builder defines it (layer/builder,
+// classify.h):
+//   triangles  per primitive: active (no vertex's X is NaN), undefined input (a NaN Y or Z with X not NaN, active
+//              primitives only), unreadable (an index that names a vertex above maxVertex: never read);
+//   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
+//   instances  per record: its accelerationStructureReference, and whether its transform has a NaN or infinite
+//              element (per 32 records, the first such one's element too).
+// One bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count.
+//
+// No descriptor set, no push constant: the app's own stay as they are. A job's parameters lie in the capture
+// slab this pipeline was made for (its device address is the specialization constant), 16 * job bytes in, where
+// job = base group Y | base group Z << 15 (vkCmdDispatchBase); the X groups walk the primitives (a grid-stride
+// loop beyond 65535 groups). Addresses are uvec2 (no shaderInt64 needed); every load is a 32-bit load of an
+// aligned word that holds at least one byte of what is read, so it never leaves a page the build reads itself.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+
+layout(local_size_x = 64) in;
+
+layout(constant_id = 0) const uint kSlabLo = 0u;
+layout(constant_id = 1) const uint kSlabHi = 0u;
+
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Words { uint w[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer OutWords { uint w[]; };
+
+// Must match ReduceJob (layer/capture/capture_reducer.h).
+struct Job {
+  uint kind;          // 0 triangles, 1 AABBs, 2 instances
+  uint count;         // primitives
+  uint stride;        // vertex, AABB or instance stride in bytes
+  uint x_kind;        // triangles: 0 no NaN (normalized formats), 1 float32, 2 float16
+  uint components;    // triangles: 2 or 3 (Y and Z tested for the undefined-input bit)
+  uint index_bytes;   // triangles: 0 (not indexed), 1, 2 or 4
+  uint first_vertex;  // indexed triangles: added to each index
+  uint max_vertex;    // indexed triangles: the highest vertex that may be read
+  uvec2 data;         // vertices (not indexed: the first one read), AABBs or instance records
+  uvec2 indices;      // indexed triangles: the first index read
+  uvec2 out_addr;     // results
+  uvec2 unused;
+};
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer JobRef { Job job; };
+
+uvec2 Add64(uvec2 a, uint lo, uint hi) {
+  uint carry;
+  const uint l = uaddCarry(a.x, lo, carry);
+  return uvec2(l, a.y + hi + carry);
+}
+uvec2 AddProduct(uvec2 a, uint x, uint y) {
+  uint hi, lo;
+  umulExtended(x, y, hi, lo);
+  return Add64(a, lo, hi);
+}
+
+// `bytes` (1, 2 or 4) little-endian bytes at any byte address.
+uint LoadBytes(uvec2 address, uint bytes) {
+  const uint misalign = address.x & 3u;
+  const uvec2 base = uvec2(address.x & ~3u, address.y);
+  uint value = Words(base).w[0] >> (8u * misalign);
+  if (misalign + bytes > 4u) value |= Words(base).w[1] << (32u - 8u * misalign);
+  return bytes == 4u ? value : value & ((1u << (8u * bytes)) - 1u);
+}
+
+bool NaN32(uint bits) { return (bits & 0x7fffffffu) > 0x7f800000u; }
+bool NaN16(uint bits) { return (bits & 0x7fffu) > 0x7c00u; }
+bool NonFinite32(uint bits) { return (bits & 0x7f800000u) == 0x7f800000u; }
+
+// This group's 64 primitives: three bit arrays of two words (instances: the third holds the first non-finite
+// transform's lane and element per word instead).
+shared uint s_bits[3][2];
+
+void main() {
+  const uint job_index = gl_WorkGroupID.y | (gl_WorkGroupID.z << 15);
+  const Job job = JobRef(AddProduct(uvec2(kSlabLo, kSlabHi), job_index, 16u)).job;
+  const uint words = (job.count + 31u) / 32u;
+  const uint local = gl_LocalInvocationID.x;
+  // Uniform over the group: every invocation takes part in each round's barriers.
+  for (uint group_first = gl_WorkGroupID.x * 64u; group_first < job.count; group_first += gl_NumWorkGroups.x * 64u) {
+    if (local < 6u) s_bits[local / 2u][local % 2u] = (job.kind == 2u && local >= 4u) ? 0xffffffffu : 0u;
+    barrier();
+    const uint t = group_first + local;
+    bool is_active = false, undefined_input = false, unreadable = false;
+    if (t < job.count) {
+      if (job.kind == 0u) {
+        uint v[3];
+        for (uint k = 0u; k < 3u; ++k) {
+          if (job.index_bytes == 0u) {
+            v[k] = 3u * t + k;
+          } else {
+            const uint index = LoadBytes(AddProduct(job.indices, 3u * t + k, job.index_bytes), job.index_bytes);
+            uint carry;
+            v[k] = uaddCarry(index, job.first_vertex, carry);
+            unreadable = unreadable || carry != 0u || v[k] > job.max_vertex;
+          }
+        }
+        bool x_nan = false, yz_nan = false;
+        if (!unreadable && job.x_kind != 0u) {
+          for (uint k = 0u; k < 3u; ++k) {
+            const uvec2 p = AddProduct(job.data, v[k], job.stride);
+            if (job.x_kind == 1u) {
+              x_nan = x_nan || NaN32(LoadBytes(p, 4u));
+              yz_nan = yz_nan || NaN32(LoadBytes(Add64(p, 4u, 0u), 4u));
+              if (job.components > 2u) yz_nan = yz_nan || NaN32(LoadBytes(Add64(p, 8u, 0u), 4u));
+            } else {
+              x_nan = x_nan || NaN16(LoadBytes(p, 2u));
+              yz_nan = yz_nan || NaN16(LoadBytes(Add64(p, 2u, 0u), 2u));
+              if (job.components > 2u) yz_nan = yz_nan || NaN16(LoadBytes(Add64(p, 4u, 0u), 2u));
+            }
+          }
+        }
+        is_active = unreadable || !x_nan;  // unreadable: recorded active, as the builder does (and then unknown)
+        undefined_input = !unreadable && !x_nan && yz_nan;
+      } else if (job.kind == 1u) {
+        const uvec2 p = AddProduct(job.data, t, job.stride);
+        const bool min_x_nan = NaN32(LoadBytes(p, 4u));
+        bool other_nan = false;
+        for (uint c = 1u; c < 6u; ++c) other_nan = other_nan || NaN32(LoadBytes(Add64(p, 4u * c, 0u), 4u));
+        is_active = !min_x_nan;
+        undefined_input = !min_x_nan && other_nan;
+      } else {
+        const uvec2 p = AddProduct(job.data, t, job.stride);
+        uint first_element = 12u;  // the first NaN or infinite element of the transform (row * 4 + column)
+        for (uint c = 12u; c > 0u; --c) {
+          if (NonFinite32(LoadBytes(Add64(p, 4u * (c - 1u), 0u), 4u))) first_element = c - 1u;
+        }
+        const bool non_finite = first_element < 12u;
+        // The group's first such instance per word, with its element: (lane << 4) | element, the least wins.
+        if (non_finite) atomicMin(s_bits[2][local / 32u], ((local % 32u) << 4) | first_element);
+        const uint ref_lo = LoadBytes(Add64(p, 56u, 0u), 4u);
+        const uint ref_hi = LoadBytes(Add64(p, 60u, 0u), 4u);
+        OutWords refs = OutWords(AddProduct(job.out_addr, t, 8u));
+        refs.w[0] = ref_lo;
+        refs.w[1] = ref_hi;
+        undefined_input = non_finite;  // the instances' second bit array: a non-finite transform
+      }
+      const uint bit = 1u << (local % 32u);
+      if (is_active) atomicOr(s_bits[0][local / 32u], bit);
+      if (undefined_input) atomicOr(s_bits[1][local / 32u], bit);
+      if (unreadable) atomicOr(s_bits[2][local / 32u], bit);
+    }
+    barrier();
+    const uint word = group_first / 32u + local % 2u;
+    if (local < 6u && word < words) {
+      // Triangles and AABBs: active, undefined, unreadable arrays one after the other; instances: the references
+      // (8 bytes each), then the non-finite transform array, then per word its first such instance's
+      // (lane << 4) | element (all ones: none).
+      const uint array = local / 2u;
+      if (job.kind != 2u) {
+        OutWords(AddProduct(job.out_addr, array * words + word, 4u)).w[0] = s_bits[array][local % 2u];
+      } else if (array != 0u) {
+        OutWords(Add64(AddProduct(job.out_addr, job.count, 8u), ((array - 1u) * words + word) * 4u, 0u)).w[0] =
+            s_bits[array][local % 2u];
+      }
+    }
+    barrier();
+  }
+}
