@@ -22,9 +22,11 @@ uint32_t PickMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t
 }  // namespace
 
 CapturePool::CapturePool(VkDevice device, const DeviceDispatchTable& next,
-                         const VkPhysicalDeviceMemoryProperties& memory, std::unique_ptr<CaptureReducer> reducer)
-    : device_(device), next_(next), reducer_(std::move(reducer)), reduces_(reducer_ != nullptr) {
+                         const VkPhysicalDeviceMemoryProperties& memory, bool reduce)
+    : device_(device), next_(next) {
   memory_type_ = PickMemoryType(memory, ~0u);
+  if (reduce) reducer_ = CaptureReducer::Create(device, next, memory_type_);  // null: the capture copies
+  reduces_ = reducer_ != nullptr;
 }
 
 CapturePool::~CapturePool() { Shutdown(); }
@@ -60,18 +62,17 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
   }
   s.mapped = static_cast<uint8_t*>(mapped);
   if (reducer_) {
-    // No pipeline (its creation failed): this slab's captures are copied.
+    // Not in the table (full): this slab's captures are copied.
     VkBufferDeviceAddressInfo address{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
     address.buffer = s.buffer;
     s.address = next_.GetBufferDeviceAddress(device_, &address);
-    if (s.address != 0) s.reduce_pipeline = reducer_->MakePipeline(s.address);
+    s.table_index = reducer_->Register(s.address);
   }
   *slab = s;
   return true;
 }
 
 void CapturePool::Destroy(const CaptureSlab& slab) {
-  if (reducer_) reducer_->DestroyPipeline(slab.reduce_pipeline);
   next_.DestroyBuffer(device_, slab.buffer, nullptr);
   next_.FreeMemory(device_, slab.memory, nullptr);  // unmaps
 }

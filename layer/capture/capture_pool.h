@@ -20,10 +20,10 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   // Slabs are at least this large (a slab serves many captures of one recording).
   static constexpr VkDeviceSize kSlabBytes = VkDeviceSize{4} << 20;
 
-  // `reducer` (may be null): the capture reduces on the device (capture_method); every slab then gets a device
-  // address and the reducer's pipeline for it.
+  // `reduce`: the capture reduces on the device (capture_method, CaptureReduces) where the device lets the
+  // reducer be made; every slab then gets a device address and a place in the reducer's slab table.
   CapturePool(VkDevice device, const DeviceDispatchTable& next, const VkPhysicalDeviceMemoryProperties& memory,
-              std::unique_ptr<CaptureReducer> reducer = nullptr);
+              bool reduce = false);
   ~CapturePool() override;
 
   // A slab of at least `bytes`; nullopt when the device cannot give one (no host-visible coherent memory type,
@@ -32,8 +32,10 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   void Return(const CaptureSlab& slab) override;
   // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
   void Shutdown();
-  // The capture reduces on the device (slabs have a pipeline each).
+  // The capture reduces on the device (CaptureLog::TableIndexOf says where a slab is in the table).
   bool reduces() const { return reduces_; }
+  // The reducing pipeline (compiled at the first call; null when it could not be: the captures are then copied).
+  VkPipeline ReducePipeline() { return reducer_ ? reducer_->Pipeline() : VK_NULL_HANDLE; }
 
  private:
   bool Create(VkDeviceSize bytes, CaptureSlab* slab);
@@ -41,9 +43,9 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
 
   const VkDevice device_;
   const DeviceDispatchTable& next_;
-  std::unique_ptr<CaptureReducer> reducer_;  // until Shutdown
-  const bool reduces_;
   uint32_t memory_type_ = UINT32_MAX;  // HOST_VISIBLE | HOST_COHERENT, HOST_CACHED preferred (the host reads)
+  std::unique_ptr<CaptureReducer> reducer_;  // until Shutdown
+  bool reduces_ = false;                     // set at construction
   std::mutex mutex_;
   std::vector<CaptureSlab> free_;
   std::vector<CaptureSlab> all_;  // every live slab, for Shutdown

@@ -29,19 +29,20 @@ struct Copy {
   VkBufferCopy region;
 };
 
-// One reducing dispatch (capture_reducer.h): the pipeline of the slab holding its job, and where the job is.
+// The one reducing dispatch of a command (capture_reducer.h): its first job and how many follow it, and the X
+// groups the largest needs.
 struct Dispatch {
-  VkPipeline pipeline;
-  uint32_t job_y;  // the job's offset in 16-byte units: low 15 bits
-  uint32_t job_z;  // ... and the rest
-  uint32_t groups;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  uint32_t first_job = 0;
+  uint32_t jobs = 0;
+  uint32_t groups = 0;
 };
 
-// The captures of one command, between two barriers: copies, then the reducing dispatches (after which the app's
+// The captures of one command, between two barriers: copies, then the reducing dispatch (after which the app's
 // compute pipeline, `app_pipeline`, is bound again).
 void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies,
-                    const std::vector<Dispatch>& dispatches, VkPipeline app_pipeline) {
-  const bool reduces = !dispatches.empty();
+                    const Dispatch& dispatch, VkPipeline app_pipeline) {
+  const bool reduces = dispatch.jobs != 0;
   // Earlier writes of any kind (the app's own copies, fills, shaders) become visible to the transfer read (and to
   // the layer's shader, which reads the inputs through their device addresses).
   VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
@@ -52,14 +53,12 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
                               1, &before, 0, nullptr, 0, nullptr);
   for (const Copy& c : copies) ctx.next.CmdCopyBuffer(cb, c.src, c.dst, 1, &c.region);
   if (reduces) {
-    VkPipeline bound = VK_NULL_HANDLE;
-    for (const Dispatch& d : dispatches) {
-      if (d.pipeline != bound) ctx.next.CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, bound = d.pipeline);
-      ctx.next.CmdDispatchBase(cb, 0, d.job_y, d.job_z, d.groups, 1, 1);
-    }
+    ctx.next.CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch.pipeline);
+    ctx.next.CmdDispatchBase(cb, 0, dispatch.first_job % 32768, dispatch.first_job / 32768, dispatch.groups,
+                             dispatch.jobs, 1);
     if (app_pipeline != VK_NULL_HANDLE) ctx.next.CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, app_pipeline);
   }
-  // The copies (and the dispatches' writes) are visible to the host once the submission completes; later
+  // The copies (and the dispatch's writes) are visible to the host once the submission completes; later
   // commands (writes of the inputs included) wait for the reads. Later writes into the same capture bytes (a
   // secondary command buffer executed twice, whose capture is then unknown anyway) are ordered after these writes
   // too: without them here they would race (a write-after-write hazard that synchronization validation reports).
@@ -73,8 +72,7 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
 }
 
 void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies) {
-  static const std::vector<Dispatch> kNone;
-  RecordCaptures(ctx, cb, copies, kNone, VK_NULL_HANDLE);
+  RecordCaptures(ctx, cb, copies, Dispatch{}, VK_NULL_HANDLE);
 }
 
 // Whether geometry g's bytes (its `data`) can be reduced on the device instead of copied: triangles, AABBs, and
@@ -83,8 +81,8 @@ bool Reducible(const CapturedGeometry& g) {
   const uint32_t n = g.range.primitiveCount;
   if (n == 0) return false;
   switch (g.type) {
-    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
-      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 3;
+    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:  // the shader counts index bytes in 32 bits
+      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 12;
     case VK_GEOMETRY_TYPE_AABBS_KHR:
       return g.aabb_stride <= UINT32_MAX;
     case VK_GEOMETRY_TYPE_INSTANCES_KHR:
@@ -95,8 +93,9 @@ bool Reducible(const CapturedGeometry& g) {
 }
 
 // The job reading geometry g in place: its bytes at `data` (where the copy would have started), its indices at
-// `indices` (indexed triangles), its results at `out`.
-ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDeviceAddress indices, VkDeviceAddress out) {
+// `indices` (indexed triangles) and its transform at `transform` (0: none), its results at `out`.
+ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDeviceAddress indices,
+                        VkDeviceAddress transform, VkDeviceAddress out) {
   ReduceJob job;
   job.count = g.range.primitiveCount;
   job.data = data;
@@ -113,6 +112,7 @@ ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDevic
     job.first_vertex = g.range.firstVertex;
     job.max_vertex = g.max_vertex;
     job.indices = indices;
+    job.transform = transform;
   } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
     job.kind = ReduceJob::kAabbs;
     job.stride = static_cast<uint32_t>(g.aabb_stride);
@@ -176,30 +176,68 @@ void KeepRangeFacts(const VkAccelerationStructureBuildGeometryInfoKHR& info, uin
   out->range_facts = true;
 }
 
-// Geometry g's `data` source read in place by the layer's dispatch: its results and its job reserved in the log,
-// the job written, the dispatch added. False when it cannot be (no bound buffer holds the range, no room, a slab
-// without a pipeline): the info is then not captured.
-bool ReduceSource(CaptureLog& log, const CaptureSource& s, CapturedGeometry& g, const std::vector<CaptureSource>& sources,
-                  const std::optional<AddressHit>& readable, std::vector<Dispatch>& dispatches) {
-  if (!readable) return false;
-  CapturedBytes job_bytes;
-  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount), s.into) ||
-      !log.Reserve(sizeof(ReduceJob), &job_bytes)) {
+// The jobs of one command's reducing dispatch: a block in the recording's log, consecutive, in a slab the
+// reducer's table holds and within its first kReduceJobsPerSlab jobs.
+struct JobBlock {
+  bool ok = false;
+  uint8_t* slots = nullptr;
+  Dispatch dispatch;
+  uint32_t capacity = 0;
+  // Room for `capacity` jobs and the pipeline; false (the command's captures are then copied) when either is
+  // missing.
+  bool Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline) {
+    CapturedBytes bytes;
+    if (pipeline == VK_NULL_HANDLE || jobs == 0 || jobs > kReduceMaxJobsPerDispatch ||
+        !log.Reserve(VkDeviceSize{jobs} * sizeof(ReduceJob) + 48, &bytes)) {  // 48: room to align to 64
+      return false;
+    }
+    const VkDeviceSize first = (bytes.offset + 63) / 64;
+    const uint32_t table_index = log.TableIndexOf(bytes);
+    if (table_index == UINT32_MAX || first + jobs > kReduceJobsPerSlab) return false;
+    slots = log.WritableBytes(bytes) + (first * 64 - bytes.offset);
+    dispatch.pipeline = pipeline;
+    dispatch.first_job = table_index << 16 | static_cast<uint32_t>(first);
+    capacity = jobs;
+    return ok = true;
+  }
+  void Add(const ReduceJob& job) {
+    std::memcpy(slots + VkDeviceSize{dispatch.jobs} * sizeof(ReduceJob), &job, sizeof(job));
+    ++dispatch.jobs;
+    const VkDeviceSize groups = (VkDeviceSize{job.count} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup;
+    dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
+  }
+};
+
+// The sources of geometry g (its data, and for triangles its indices and transform) read in place by the command's
+// dispatch: its results reserved in the log (the indices and transform among them, where the builder's views
+// find them), its job added. False when a source cannot be read (no bound buffer holds it, the transform aside)
+// or there is no room: the info is then not captured.
+bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
+                    const CaptureSource* last, JobBlock& block) {
+  const CaptureSource* data = nullptr;
+  const CaptureSource* indices = nullptr;
+  const CaptureSource* transform = nullptr;
+  for (const CaptureSource* s = first; s != last; ++s) {
+    if (s->into == &g.data) data = s;
+    if (s->into == &g.indices) indices = s;
+    if (s->into == &g.transform && ReadableBuffer(state, s->address, s->size)) transform = s;
+  }
+  if (!data || block.dispatch.jobs >= block.capacity || !ReadableBuffer(state, data->address, data->size) ||
+      (indices && !ReadableBuffer(state, indices->address, indices->size))) {
     return false;
   }
-  const VkPipeline pipeline = log.ReducePipelineOf(job_bytes);
-  const VkDeviceSize job16 = job_bytes.offset / 16;  // Reserve is 16-aligned
-  if (pipeline == VK_NULL_HANDLE || (job16 >> 15) >= kReduceMaxGroups) return false;
-  VkDeviceAddress indices = 0;  // the same geometry's index source (planned before its vertices)
-  for (const CaptureSource& other : sources) {
-    if (other.into == &g.indices) indices = other.address;
+  const VkDeviceSize index_bytes = indices ? indices->size : 0;
+  CapturedBytes out;
+  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) return false;
+  g.data = out;
+  const VkDeviceSize bits = ReducedBitBytes(g.type, g.range.primitiveCount);
+  if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, index_bytes, true};
+  if (transform) {
+    g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
   }
-  const ReduceJob job = MakeReduceJob(g, s.address, indices, log.AddressOf(*s.into));
-  std::memcpy(log.WritableBytes(job_bytes), &job, sizeof(job));
   g.reduced = true;
-  const uint32_t groups = static_cast<uint32_t>(std::min<VkDeviceSize>(
-      (VkDeviceSize{g.range.primitiveCount} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup, kReduceMaxGroups));
-  dispatches.push_back(Dispatch{pipeline, static_cast<uint32_t>(job16 & 0x7fff), static_cast<uint32_t>(job16 >> 15), groups});
+  block.Add(MakeReduceJob(g, data->address, indices ? indices->address : 0, transform ? transform->address : 0,
+                          log.AddressOf(out)));
   return true;
 }
 
@@ -257,17 +295,17 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
                         std::vector<uint32_t>& captured) {
   captured.clear();
   if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
-  const bool reduces = ctx.pool.reduces();
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
   thread_local std::vector<Copy> copies;
-  thread_local std::vector<Dispatch> dispatches;
   thread_local std::vector<CaptureSource> sources;
-  thread_local std::vector<uint32_t> source_geometry;  // per source: its geometry
-  thread_local std::vector<uint8_t> source_reduced;    // per source: read in place by the layer's dispatch
+  thread_local std::vector<uint32_t> first_source;     // per geometry, and one past the last
+  thread_local std::vector<uint8_t> reduced;           // per geometry: read in place by the command's dispatch
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   thread_local std::vector<CommandDestination> destinations;
   copies.clear();
-  dispatches.clear();
+  // capture_method reduce: one dispatch for the command, its jobs in one block, taken at the first capture.
+  JobBlock block;
+  bool block_tried = !ctx.pool.reduces();
   bool destinations_logged = false;
   uint32_t first_destination = 0;
   for (uint32_t i = 0; i < info_count; ++i) {
@@ -282,6 +320,15 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
       continue;
     }
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
+    if (!block_tried) {  // room for a job per geometry of the infos captured from here on
+      uint32_t jobs = 0;
+      for (uint32_t k = i; k < info_count; ++k) {
+        if (NeedsCapture(ctx.mode, infos[k])) jobs += std::min(infos[k].geometryCount, kReduceMaxJobsPerDispatch + 1);
+        jobs = std::min(jobs, kReduceMaxJobsPerDispatch + 1);
+      }
+      block.Acquire(log, jobs, ctx.pool.ReducePipeline());
+      block_tried = true;
+    }
     CapturedInfo entry;
     entry.geometry_count = info.geometryCount;
     entry.element = i;
@@ -296,46 +343,57 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     }
     planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
-    source_geometry.clear();
+    first_source.assign(1, 0);
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
       entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources);
-      source_geometry.resize(sources.size(), j);
+      first_source.push_back(static_cast<uint32_t>(sources.size()));
     }
-    // What each source costs: its bytes, or what the dispatch writes for it (and its job).
-    source_reduced.assign(sources.size(), 0);
+    // What the info costs: each geometry's bytes, or what the dispatch writes for it and its job.
+    reduced.assign(first_source.size() - 1, 0);
     VkDeviceSize total = 0;
-    for (std::size_t k = 0; k < sources.size(); ++k) {
-      const CapturedGeometry& g = planned[source_geometry[k]];
-      source_reduced[k] = reduces && sources[k].into == &g.data && Reducible(g);
-      total = SaturatingAddBytes(
-          total, source_reduced[k] ? ReducedBytes(g.type, g.range.primitiveCount) + sizeof(ReduceJob) : sources[k].size);
+    for (std::size_t j = 0; j < reduced.size(); ++j) {
+      const CapturedGeometry& g = planned[j];
+      reduced[j] = block.ok && Reducible(g);
+      VkDeviceSize index_bytes = 0;
+      bool transform = false;
+      for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
+        if (!reduced[j]) total = SaturatingAddBytes(total, sources[k].size);
+        if (sources[k].into == &g.indices) index_bytes = sources[k].size;
+        if (sources[k].into == &g.transform) transform = true;
+      }
+      if (reduced[j]) {
+        total = SaturatingAddBytes(
+            total, ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform) + sizeof(ReduceJob));
+      }
     }
     if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
       entry.complete = false;
       ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
     }
     const std::size_t first_copy = copies.size();
-    const std::size_t first_dispatch = dispatches.size();
-    for (std::size_t k = 0; k < sources.size() && entry.complete; ++k) {
-      const CaptureSource& s = sources[k];
-      if (source_reduced[k]) {
-        entry.complete = ReduceSource(log, s, planned[source_geometry[k]], sources, ReadableBuffer(ctx.state, s.address, s.size),
-                                      dispatches);
+    const uint32_t first_job = block.dispatch.jobs;
+    for (std::size_t j = 0; j < reduced.size() && entry.complete; ++j) {
+      if (reduced[j]) {
+        entry.complete = ReduceGeometry(ctx.state, log, planned[j], sources.data() + first_source[j],
+                                        sources.data() + first_source[j + 1], block);
         continue;
       }
-      const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
-      if (!hit && s.optional) continue;
-      if (!hit || !log.Reserve(s.size, s.into)) {
-        entry.complete = false;
-        break;
+      for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
+        const CaptureSource& s = sources[k];
+        const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
+        if (!hit && s.optional) continue;
+        if (!hit || !log.Reserve(s.size, s.into)) {
+          entry.complete = false;
+          break;
+        }
+        copies.push_back(
+            Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
       }
-      copies.push_back(
-          Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
     }
     if (!entry.complete) {
       copies.resize(first_copy);
-      dispatches.resize(first_dispatch);
+      block.dispatch.jobs = first_job;
       ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
     } else {
       ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
@@ -343,8 +401,8 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     }
     captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
-  if (!copies.empty() || !dispatches.empty()) {
-    RecordCaptures(ctx, cb, copies, dispatches, recording.compute_pipeline);
+  if (!copies.empty() || block.dispatch.jobs != 0) {
+    RecordCaptures(ctx, cb, copies, block.dispatch, recording.compute_pipeline);
   }
   return !captured.empty();
 }

@@ -10,8 +10,10 @@
 // recorder binds again afterwards (CommandBufferState::compute_pipeline); it is the one piece of app state touched.
 #include <vulkan/vulkan.h>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 
 #include "layer_settings.h"
 #include "vk_dispatch_table.h"
@@ -33,14 +35,18 @@ struct ReduceJob {
   uint64_t data = 0;          // vertices (not indexed: the first one read), AABBs or instance records
   uint64_t indices = 0;       // indexed triangles: the first index read
   uint64_t out = 0;           // where the results go (ReducedGeometry, capture_log.h)
-  uint64_t unused = 0;
+  uint64_t transform = 0;     // triangles: the transform, copied after the indices (0: none, or not captured)
 };
 static_assert(sizeof(ReduceJob) == 64, "ReduceJob must match reduce_inputs.comp's Job");
 
-// Workgroups of the dispatch: its X groups walk the primitives, 64 per group (beyond 65535 groups, each group
-// takes several rounds); Y and Z name the job (16-byte units into its slab, 15 bits in Y, the rest in Z).
+// The dispatch: its X groups walk the primitives, 64 per group (beyond 65535 groups, each group takes several
+// rounds); each row of Y groups is one job: job = group Y + 32768 * group Z, naming slab job >> 16 of the
+// reducer's table and the job 64 * (job & 0xffff) bytes into that slab (vkCmdDispatchBase sets the first).
 inline constexpr uint32_t kReducePrimitivesPerGroup = 64;
-inline constexpr uint32_t kReduceMaxGroups = 65535;  // the least maxComputeWorkGroupCount[0] a device has
+inline constexpr uint32_t kReduceMaxGroups = 65535;         // the least maxComputeWorkGroupCount a device has
+inline constexpr uint32_t kReduceJobsPerSlab = 1u << 16;    // jobs lie in a slab's first 4 MiB
+inline constexpr uint32_t kReduceMaxJobsPerDispatch = 32767;  // Y rows, so that base Y + rows <= 65535
+inline constexpr uint32_t kReduceSlabs = 4096;              // slabs the table holds (job >> 16 < 16384)
 
 // Whether a device's capture reduces (capture_method): `auto` on a device that is not a CPU (where the host's
 // classification shares the cores with the device's own work anyway, and lavapipe's compute dispatches cost more
@@ -55,15 +61,20 @@ inline bool CaptureReduces(CaptureMethod method, VkPhysicalDeviceType type, bool
 
 class CaptureReducer {
  public:
-  // The shader module and layout, or null when the device cannot run the pipeline (a command missing).
-  static std::unique_ptr<CaptureReducer> Create(VkDevice device, const DeviceDispatchTable& next);
+  // The shader module, layout and slab table (in `memory_type`: host-visible and coherent), or null when the
+  // device cannot run the pipeline (a command missing, no memory).
+  static std::unique_ptr<CaptureReducer> Create(VkDevice device, const DeviceDispatchTable& next,
+                                                uint32_t memory_type);
   ~CaptureReducer();
   CaptureReducer(const CaptureReducer&) = delete;
   CaptureReducer& operator=(const CaptureReducer&) = delete;
 
-  // A pipeline reading its jobs from the slab at `slab_address` (made when the slab is); null on failure.
-  VkPipeline MakePipeline(VkDeviceAddress slab_address) const;
-  void DestroyPipeline(VkPipeline pipeline) const;
+  // The pipeline, compiled at the first call (the first reduced capture of the device; a driver may take a
+  // noticeable time once); null when that failed: the captures are then copied.
+  VkPipeline Pipeline();
+  // Enters a slab's device address in the table: its index, or UINT32_MAX when the table is full (the slab's
+  // captures are then copied).
+  uint32_t Register(VkDeviceAddress slab);
 
  private:
   CaptureReducer(VkDevice device, const DeviceDispatchTable& next) : device_(device), next_(next) {}
@@ -71,6 +82,15 @@ class CaptureReducer {
   const DeviceDispatchTable& next_;
   VkShaderModule module_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  // The slab table: kReduceSlabs device addresses, host-visible (written when a slab is made, before any
+  // submission can read it).
+  VkBuffer table_ = VK_NULL_HANDLE;
+  VkDeviceMemory table_memory_ = VK_NULL_HANDLE;
+  VkDeviceAddress* table_entries_ = nullptr;
+  VkDeviceAddress table_address_ = 0;
+  std::atomic<uint32_t> slabs_{0};
+  std::once_flag compiled_;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
 };
 
 }  // namespace asval

@@ -151,14 +151,12 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   // Execution-time capture: needs the history (its records live there).
   if (data->state.history_tracked && instance->settings.capture != kCaptureOff) {
-    std::unique_ptr<CaptureReducer> reducer;
-    if (CaptureReduces(settings.capture_method, data->state.properties.core.deviceType,
-                       data->state.features.buffer_device_address, EnablesExtension(*pCreateInfo, "VK_EXT_shader_object"),
-                       (settings.capture_warnings & kCaptureWarnFloatSpacing) != 0)) {
-      reducer = CaptureReducer::Create(*pDevice, data->dispatch);  // null: the capture copies
-    }
+    const bool reduce = CaptureReduces(settings.capture_method, data->state.properties.core.deviceType,
+                                       data->state.features.buffer_device_address,
+                                       EnablesExtension(*pCreateInfo, "VK_EXT_shader_object"),
+                                       (settings.capture_warnings & kCaptureWarnFloatSpacing) != 0);
     data->capture_pool =
-        std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, std::move(reducer));
+        std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, reduce);
     data->capture_tracker = std::make_unique<CaptureTracker>(*pDevice, data->dispatch);
   }
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));

@@ -51,10 +51,10 @@ struct CaptureSlab {
   VkDeviceMemory memory = VK_NULL_HANDLE;
   uint8_t* mapped = nullptr;  // host-visible, coherent, mapped for the slab's lifetime
   VkDeviceSize size = 0;
-  // capture_method reduce (layer/capture/capture_reducer.h): the slab's device address, and the layer's compute
-  // pipeline that reads its jobs from this slab; null when the capture copies.
+  // capture_method reduce (layer/capture/capture_reducer.h): the slab's device address, and its index in the
+  // reducer's slab table (UINT32_MAX: not in it; what is captured into it is copied).
   VkDeviceAddress address = 0;
-  VkPipeline reduce_pipeline = VK_NULL_HANDLE;
+  uint32_t table_index = UINT32_MAX;
 };
 
 // Where slabs come from and go back to (layer/capture's pool; destroyed with the device).
@@ -103,12 +103,17 @@ struct CapturedGeometry {
 // What the layer's dispatch wrote for a reduced geometry of `count` primitives (layer/capture/shaders/
 // reduce_inputs.comp): bit arrays of one bit per primitive in 32-bit words (bit t % 32 of word t / 32, zero past
 // the count). Triangles and AABBs: active, undefined input, unreadable (an index naming a vertex above maxVertex,
-// not read). Instances: each record's accelerationStructureReference (8 bytes each), then the records whose
-// transform has a NaN or infinite element, then per 32 records the first such one's (lane << 4) | element.
+// not read); indexed triangles then their index bytes (CapturedGeometry::indices points there), rounded up to
+// whole words, and triangles with a captured transform its 48 bytes (CapturedGeometry::transform). Instances:
+// each record's accelerationStructureReference (8 bytes each), then the records whose transform has a NaN or
+// infinite element, then per 32 records the first such one's (lane << 4) | element.
 inline uint32_t ReducedWords(uint32_t count) { return (count + 31) / 32; }
-inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count) {
+inline VkDeviceSize ReducedBitBytes(VkGeometryTypeKHR type, uint32_t count) {
   const VkDeviceSize words = ReducedWords(count);
   return type == VK_GEOMETRY_TYPE_INSTANCES_KHR ? 8 * VkDeviceSize{count} + 2 * 4 * words : 3 * 4 * words;
+}
+inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count, VkDeviceSize index_bytes, bool transform) {
+  return ReducedBitBytes(type, count) + (index_bytes + 3) / 4 * 4 + (transform ? 48 : 0);
 }
 struct ReducedGeometry {
   const uint8_t* base;
@@ -176,9 +181,9 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   ReducedGeometry Reduced(const CapturedGeometry& g) const { return ReducedGeometry{Bytes(g.data), g.range.primitiveCount}; }
   // The slab's buffer the device copies `bytes` into.
   VkBuffer BufferOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].buffer; }
-  // capture_method reduce: where the device writes `bytes`, and the pipeline that reads jobs from their slab.
+  // capture_method reduce: where the device writes `bytes`, and their slab's index in the reducer's table.
   VkDeviceAddress AddressOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].address + bytes.offset; }
-  VkPipeline ReducePipelineOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].reduce_pipeline; }
+  uint32_t TableIndexOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].table_index; }
   // The recording thread writes a reduce job's parameters (before any submission reads them).
   uint8_t* WritableBytes(const CapturedBytes& bytes) { return slabs[bytes.slab].mapped + bytes.offset; }
 

@@ -1,30 +1,33 @@
 #version 460
 // Execution-time capture, reduced on the device (issue 12, setting capture_method): instead of copying a build's
-// vertices, AABBs or instance records to the host, one dispatch per captured geometry reads them where the build
-// reads them and writes only what the rules need, as the reference builder defines it (layer/builder,
-// classify.h):
+// vertices, AABBs or instance records to the host, the layer's dispatch reads them where the build reads them
+// and writes only what the rules need, as the reference builder defines it (layer/builder, classify.h):
 //   triangles  per primitive: active (no vertex's X is NaN), undefined input (a NaN Y or Z with X not NaN, active
-//              primitives only), unreadable (an index that names a vertex above maxVertex: never read);
+//              primitives only), unreadable (an index that names a vertex above maxVertex: never read); and the
+//              index bytes and the transform as they are (the host hashes the indices);
 //   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
 //   instances  per record: its accelerationStructureReference, and whether its transform has a NaN or infinite
 //              element (per 32 records, the first such one's element too).
-// One bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count.
+// Bit arrays hold one bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count. The
+// layout of the results is ReducedGeometry's (layer/state/capture_log.h).
 //
-// No descriptor set, no push constant: the app's own stay as they are. A job's parameters lie in the capture
-// slab this pipeline was made for (its device address is the specialization constant), 16 * job bytes in, where
-// job = base group Y | base group Z << 15 (vkCmdDispatchBase); the X groups walk the primitives (a grid-stride
-// loop beyond 65535 groups). Addresses are uvec2 (no shaderInt64 needed); every load is a 32-bit load of an
-// aligned word that holds at least one byte of what is read, so it never leaves a page the build reads itself.
+// No descriptor set, no push constant: the app's own stay as they are. The specialization constant is the
+// device address of the capture pool's slab table (one device address per slab); each row of Y groups is one
+// job: job = group Y + 32768 * group Z (vkCmdDispatchBase), whose slab is job >> 16 and whose parameters lie
+// 64 * (job & 0xffff) bytes into it. The X groups walk the primitives (a grid-stride loop beyond 65535 groups).
+// Addresses are uvec2 (no shaderInt64 needed); every load is a 32-bit load of an aligned word that holds at least
+// one byte of what is read, so it never leaves a page the build reads itself.
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
 
 layout(local_size_x = 64) in;
 
-layout(constant_id = 0) const uint kSlabLo = 0u;
-layout(constant_id = 1) const uint kSlabHi = 0u;
+layout(constant_id = 0) const uint kTableLo = 0u;
+layout(constant_id = 1) const uint kTableHi = 0u;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer Words { uint w[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) writeonly buffer OutWords { uint w[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Addresses { uvec2 a[]; };
 
 // Must match ReduceJob (layer/capture/capture_reducer.h).
 struct Job {
@@ -39,7 +42,7 @@ struct Job {
   uvec2 data;         // vertices (not indexed: the first one read), AABBs or instance records
   uvec2 indices;      // indexed triangles: the first index read
   uvec2 out_addr;     // results
-  uvec2 unused;
+  uvec2 transform;    // triangles: the transform (0: none, or not captured)
 };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer JobRef { Job job; };
 
@@ -54,7 +57,7 @@ uvec2 AddProduct(uvec2 a, uint x, uint y) {
   return Add64(a, lo, hi);
 }
 
-// `bytes` (1, 2 or 4) little-endian bytes at any byte address.
+// `bytes` (1 to 4) little-endian bytes at any byte address.
 uint LoadBytes(uvec2 address, uint bytes) {
   const uint misalign = address.x & 3u;
   const uvec2 base = uvec2(address.x & ~3u, address.y);
@@ -72,12 +75,27 @@ bool NonFinite32(uint bits) { return (bits & 0x7f800000u) == 0x7f800000u; }
 shared uint s_bits[3][2];
 
 void main() {
-  const uint job_index = gl_WorkGroupID.y | (gl_WorkGroupID.z << 15);
-  const Job job = JobRef(AddProduct(uvec2(kSlabLo, kSlabHi), job_index, 16u)).job;
+  const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
+  const uvec2 slab = Addresses(uvec2(kTableLo, kTableHi)).a[job_index >> 16];
+  const Job job = JobRef(AddProduct(slab, job_index & 0xffffu, 64u)).job;
   const uint words = (job.count + 31u) / 32u;
   const uint local = gl_LocalInvocationID.x;
+  const uint stride_x = gl_NumWorkGroups.x * 64u;
+  // Triangles: the index bytes (rounded up to words) and the transform, copied after the bit arrays.
+  if (job.kind == 0u) {
+    const uvec2 out_indices = AddProduct(job.out_addr, 3u * words, 4u);
+    const uint index_total = 3u * job.count * job.index_bytes;
+    for (uint w = gl_WorkGroupID.x * 64u + local; 4u * w < index_total; w += stride_x) {
+      OutWords(AddProduct(out_indices, w, 4u)).w[0] =
+          LoadBytes(AddProduct(job.indices, w, 4u), min(4u, index_total - 4u * w));
+    }
+    if (gl_WorkGroupID.x == 0u && local < 12u && job.transform != uvec2(0u)) {
+      const uvec2 out_transform = AddProduct(out_indices, (index_total + 3u) / 4u, 4u);
+      OutWords(AddProduct(out_transform, local, 4u)).w[0] = LoadBytes(AddProduct(job.transform, local, 4u), 4u);
+    }
+  }
   // Uniform over the group: every invocation takes part in each round's barriers.
-  for (uint group_first = gl_WorkGroupID.x * 64u; group_first < job.count; group_first += gl_NumWorkGroups.x * 64u) {
+  for (uint group_first = gl_WorkGroupID.x * 64u; group_first < job.count; group_first += stride_x) {
     if (local < 6u) s_bits[local / 2u][local % 2u] = (job.kind == 2u && local >= 4u) ? 0xffffffffu : 0u;
     barrier();
     const uint t = group_first + local;
@@ -128,11 +146,9 @@ void main() {
         const bool non_finite = first_element < 12u;
         // The group's first such instance per word, with its element: (lane << 4) | element, the least wins.
         if (non_finite) atomicMin(s_bits[2][local / 32u], ((local % 32u) << 4) | first_element);
-        const uint ref_lo = LoadBytes(Add64(p, 56u, 0u), 4u);
-        const uint ref_hi = LoadBytes(Add64(p, 60u, 0u), 4u);
         OutWords refs = OutWords(AddProduct(job.out_addr, t, 8u));
-        refs.w[0] = ref_lo;
-        refs.w[1] = ref_hi;
+        refs.w[0] = LoadBytes(Add64(p, 56u, 0u), 4u);
+        refs.w[1] = LoadBytes(Add64(p, 60u, 0u), 4u);
         undefined_input = non_finite;  // the instances' second bit array: a non-finite transform
       }
       const uint bit = 1u << (local % 32u);
