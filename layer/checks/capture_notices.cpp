@@ -137,10 +137,10 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
     if (g.reduced) {  // no records here: the dispatch's bits, and its first element per 32 records
       const ReducedGeometry reduced = log->Reduced(g);
       for (uint32_t w = 0; w < ReducedWords(reduced.count); ++w) {
-        const uint32_t bits = reduced.InstanceWord(0, w);
+        const uint32_t bits = reduced.Word(ReducedGeometry::kNonFinite, w);
         if (bits == 0) continue;
         if (count == 0) {
-          const uint32_t lane_element = reduced.InstanceWord(1, w);
+          const uint32_t lane_element = reduced.Word(ReducedGeometry::kFirstNonFinite, w);
           first = 32 * w + (lane_element >> 4);
           element = static_cast<int>(lane_element & 15u);
         }

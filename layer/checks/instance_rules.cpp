@@ -200,11 +200,26 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     uint64_t bad = 0;
     bool unknown = false;
     std::string named;
+    // Instances come in runs of the same structure, or cycle through a few: the last reference, and a small table
+    // of those looked up (by a multiplicative hash: structure addresses share their low bits), spare most lookups.
+    constexpr uint32_t kRememberedBits = 6;
+    uint64_t remembered[1u << kRememberedBits] = {};
+    std::ptrdiff_t remembered_structure[1u << kRememberedBits];
+    uint64_t last = 0;
+    std::ptrdiff_t structure = -1;
     for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
       uint64_t reference = 0;
       std::memcpy(&reference, references + k * stride, sizeof(reference));
       if (reference == 0) continue;  // an inactive instance
-      const std::ptrdiff_t structure = live.Find(reference);
+      if (reference != last) {
+        const std::size_t memo = (reference * 0x9e3779b97f4a7c15ull) >> (64 - kRememberedBits);
+        if (remembered[memo] != reference) {
+          remembered[memo] = reference;
+          remembered_structure[memo] = live.Find(reference);
+        }
+        structure = remembered_structure[memo];
+        last = reference;
+      }
       if (structure >= 0) {
         if (per_structure && first[static_cast<std::size_t>(structure)].structure < 0) {
           first[static_cast<std::size_t>(structure)] = Referenced{structure, j, k};

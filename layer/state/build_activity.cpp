@@ -59,29 +59,23 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
   builder::ClassifyResult result;
   result.primitiveCount = n;
   uint32_t active = 0;
-  if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {  // active iff the reference is not 0
-    for (uint32_t k = 0; k < n; ++k) {
-      if (reduced.Reference(k) == 0) continue;
-      record->activeBits[k >> 6] |= uint64_t{1} << (k & 63);
-      ++active;
+  const bool instances = g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR;
+  for (uint32_t w = 0; w < ReducedWords(n); ++w) {
+    if (!instances && reduced.Word(ReducedGeometry::kUnreadable, w) != 0) return false;
+    const uint32_t bits = reduced.Word(ReducedGeometry::kActive, w);
+    record->activeBits[w / 2] |= uint64_t{bits} << (32 * (w % 2));
+    active += static_cast<uint32_t>(__builtin_popcount(bits));
+    if (instances) continue;  // their second array is the transforms' (the warning reads it)
+    if (const uint32_t undefined = reduced.Word(ReducedGeometry::kUndefined, w)) {
+      if (result.undefinedNaN == 0) result.firstUndefined = 32 * w + static_cast<uint32_t>(__builtin_ctz(undefined));
+      result.undefinedNaN += static_cast<uint32_t>(__builtin_popcount(undefined));
     }
-  } else {
-    for (uint32_t w = 0; w < ReducedWords(n); ++w) {
-      if (reduced.Word(2, w) != 0) return false;  // unreadable
-      const uint32_t bits = reduced.Word(0, w);
-      record->activeBits[w / 2] |= uint64_t{bits} << (32 * (w % 2));
-      active += static_cast<uint32_t>(__builtin_popcount(bits));
-      if (const uint32_t undefined = reduced.Word(1, w)) {
-        if (result.undefinedNaN == 0) result.firstUndefined = 32 * w + static_cast<uint32_t>(__builtin_ctz(undefined));
-        result.undefinedNaN += static_cast<uint32_t>(__builtin_popcount(undefined));
-      }
-    }
-    if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g.index_type != VK_INDEX_TYPE_NONE_KHR) {
-      if (!g.indices.present) return false;
-      record->hasIndexHash = true;
-      record->indexHash = builder::HashIndexBytes(log.Bytes(g.indices), static_cast<std::size_t>(g.indices.size),
-                                                  static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type)));
-    }
+  }
+  if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g.index_type != VK_INDEX_TYPE_NONE_KHR) {
+    if (!g.indices.present) return false;
+    record->hasIndexHash = true;
+    record->indexHash = builder::HashIndexBytes(log.Bytes(g.indices), static_cast<std::size_t>(g.indices.size),
+                                                static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type)));
   }
   record->activeCount = active;
   result.active = active;

@@ -101,43 +101,34 @@ struct CapturedGeometry {
 };
 
 // What the layer's dispatch wrote for a reduced geometry of `count` primitives (layer/capture/shaders/
-// reduce_inputs.comp): bit arrays of one bit per primitive in 32-bit words (bit t % 32 of word t / 32, zero past
-// the count). Triangles and AABBs: active, undefined input, unreadable (an index naming a vertex above maxVertex,
-// not read); indexed triangles then their index bytes (CapturedGeometry::indices points there), rounded up to
-// whole words, and triangles with a captured transform its 48 bytes (CapturedGeometry::transform). Instances:
-// each record's accelerationStructureReference (8 bytes each), then the records whose transform has a NaN or
-// infinite element, then per 32 records the first such one's (lane << 4) | element.
+// reduce_inputs.comp): instances first their records' accelerationStructureReference (8 bytes each); then three
+// bit arrays of one bit per primitive in 32-bit words (bit t % 32 of word t / 32, zero past the count): active;
+// undefined input (triangles: a NaN Y or Z with X not NaN; AABBs: a NaN other than minX) or, for instances, a NaN
+// or infinite element in the transform; unreadable (an index naming a vertex above maxVertex, not read) or, for
+// instances, per word the first non-finite transform's (lane << 4) | element. Indexed triangles then have their
+// index bytes (CapturedGeometry::indices points there), rounded up to whole words, and triangles with a captured
+// transform its 48 bytes (CapturedGeometry::transform).
 inline uint32_t ReducedWords(uint32_t count) { return (count + 31) / 32; }
 inline VkDeviceSize ReducedBitBytes(VkGeometryTypeKHR type, uint32_t count) {
-  const VkDeviceSize words = ReducedWords(count);
-  return type == VK_GEOMETRY_TYPE_INSTANCES_KHR ? 8 * VkDeviceSize{count} + 2 * 4 * words : 3 * 4 * words;
+  return (type == VK_GEOMETRY_TYPE_INSTANCES_KHR ? 8 * VkDeviceSize{count} : 0) + 3 * 4 * VkDeviceSize{ReducedWords(count)};
 }
 inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count, VkDeviceSize index_bytes, bool transform) {
   return ReducedBitBytes(type, count) + (index_bytes + 3) / 4 * 4 + (transform ? 48 : 0);
 }
 struct ReducedGeometry {
+  enum Array : uint32_t { kActive = 0, kUndefined = 1, kNonFinite = 1, kUnreadable = 2, kFirstNonFinite = 2 };
   const uint8_t* base;
   uint32_t count;
-  // Word w of bit array a (triangles and AABBs: 0 active, 1 undefined input, 2 unreadable).
-  uint32_t Word(uint32_t array, uint32_t w) const {
+  bool instances;
+  // Word w of bit array a.
+  uint32_t Word(Array a, uint32_t w) const {
     uint32_t v;
-    std::memcpy(&v, base + 4 * (VkDeviceSize{array} * ReducedWords(count) + w), sizeof(v));
+    const VkDeviceSize arrays = instances ? 8 * VkDeviceSize{count} : 0;
+    std::memcpy(&v, base + arrays + 4 * (VkDeviceSize{a} * ReducedWords(count) + w), sizeof(v));
     return v;
   }
-  bool Bit(uint32_t array, uint32_t t) const { return (Word(array, t / 32) >> (t % 32)) & 1u; }
-  // Instances.
-  uint64_t Reference(uint32_t k) const {
-    uint64_t v;
-    std::memcpy(&v, base + 8 * VkDeviceSize{k}, sizeof(v));
-    return v;
-  }
-  // Word w of the instances' non-finite transform array (array 0), or of its first elements (array 1: per word,
-  // (lane << 4) | element of its first such instance).
-  uint32_t InstanceWord(uint32_t array, uint32_t w) const {
-    uint32_t v;
-    std::memcpy(&v, base + 8 * VkDeviceSize{count} + 4 * (VkDeviceSize{array} * ReducedWords(count) + w), sizeof(v));
-    return v;
-  }
+  // Instances: the references.
+  const uint8_t* references() const { return base; }
 };
 
 // A destination of a build command that has a captured top-level info among several: what the rules about one
@@ -178,7 +169,9 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   CaptureLog& operator=(const CaptureLog&) = delete;
 
   const uint8_t* Bytes(const CapturedBytes& bytes) const { return slabs[bytes.slab].mapped + bytes.offset; }
-  ReducedGeometry Reduced(const CapturedGeometry& g) const { return ReducedGeometry{Bytes(g.data), g.range.primitiveCount}; }
+  ReducedGeometry Reduced(const CapturedGeometry& g) const {
+    return ReducedGeometry{Bytes(g.data), g.range.primitiveCount, g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR};
+  }
   // The slab's buffer the device copies `bytes` into.
   VkBuffer BufferOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].buffer; }
   // capture_method reduce: where the device writes `bytes`, and their slab's index in the reducer's table.

@@ -6,8 +6,8 @@
 //              primitives only), unreadable (an index that names a vertex above maxVertex: never read); and the
 //              index bytes and the transform as they are (the host hashes the indices);
 //   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
-//   instances  per record: its accelerationStructureReference, and whether its transform has a NaN or infinite
-//              element (per 32 records, the first such one's element too).
+//   instances  per record: its accelerationStructureReference, active (a reference other than 0), and whether
+//              its transform has a NaN or infinite element (per 32 records, the first such one's element too).
 // Bit arrays hold one bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count. The
 // layout of the results is ReducedGeometry's (layer/state/capture_log.h).
 //
@@ -146,10 +146,12 @@ void main() {
         const bool non_finite = first_element < 12u;
         // The group's first such instance per word, with its element: (lane << 4) | element, the least wins.
         if (non_finite) atomicMin(s_bits[2][local / 32u], ((local % 32u) << 4) | first_element);
+        const uvec2 reference = uvec2(LoadBytes(Add64(p, 56u, 0u), 4u), LoadBytes(Add64(p, 60u, 0u), 4u));
         OutWords refs = OutWords(AddProduct(job.out_addr, t, 8u));
-        refs.w[0] = LoadBytes(Add64(p, 56u, 0u), 4u);
-        refs.w[1] = LoadBytes(Add64(p, 60u, 0u), 4u);
-        undefined_input = non_finite;  // the instances' second bit array: a non-finite transform
+        refs.w[0] = reference.x;
+        refs.w[1] = reference.y;
+        is_active = reference != uvec2(0u);  // the spec's inactive instance: a reference of 0
+        undefined_input = non_finite;        // the instances' second bit array: a non-finite transform
       }
       const uint bit = 1u << (local % 32u);
       if (is_active) atomicOr(s_bits[0][local / 32u], bit);
@@ -159,16 +161,12 @@ void main() {
     barrier();
     const uint word = group_first / 32u + local % 2u;
     if (local < 6u && word < words) {
-      // Triangles and AABBs: active, undefined, unreadable arrays one after the other; instances: the references
-      // (8 bytes each), then the non-finite transform array, then per word its first such instance's
+      // Three arrays one after the other: triangles and AABBs active, undefined, unreadable; instances (after
+      // their references, 8 bytes each) active, non-finite transform, and per word its first such instance's
       // (lane << 4) | element (all ones: none).
       const uint array = local / 2u;
-      if (job.kind != 2u) {
-        OutWords(AddProduct(job.out_addr, array * words + word, 4u)).w[0] = s_bits[array][local % 2u];
-      } else if (array != 0u) {
-        OutWords(Add64(AddProduct(job.out_addr, job.count, 8u), ((array - 1u) * words + word) * 4u, 0u)).w[0] =
-            s_bits[array][local % 2u];
-      }
+      const uvec2 arrays = job.kind == 2u ? AddProduct(job.out_addr, job.count, 8u) : job.out_addr;
+      OutWords(AddProduct(arrays, array * words + word, 4u)).w[0] = s_bits[array][local % 2u];
     }
     barrier();
   }
