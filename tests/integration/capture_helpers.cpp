@@ -1,5 +1,7 @@
 #include "capture_helpers.h"
 
+#include <cstdlib>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -52,6 +54,11 @@ std::string OnlyFinding(Monitor& monitor, const char* vuid, const std::string& t
                      std::to_string(messages.size()) + " message(s):\n";
   for (const Message& m : messages) seen += m.id_name + ": " + m.text + "\n";
   return seen;
+}
+
+bool CaptureReducedRun() {
+  const char* method = std::getenv("VK_ASVAL_AS_VALIDATION_CAPTURE_METHOD");
+  return method && std::string(method) == "reduce";
 }
 
 }  // namespace asval_test
