@@ -25,8 +25,9 @@ enum class Wait { kQueueIdle, kFence, kFenceStatus, kDeviceIdle };
 // Submits cb alone and waits for it as `wait` says.
 void SubmitAndWait(vkkit::Device& device, VkCommandBuffer cb, Wait wait = Wait::kQueueIdle);
 
-// Whether this run reduces the captures on the device (CMakeLists.txt: integration_capture_reduce sets
-// VK_ASVAL_AS_VALIDATION_CAPTURE_METHOD=reduce): what a recording captures is then counted in other bytes.
+// Whether the environment makes this run reduce the captures on the device (CMakeLists.txt:
+// integration_capture_reduce sets VK_ASVAL_AS_VALIDATION_CAPTURE_METHOD=reduce, which wins over a test's
+// capture_method=copy): what a recording captures is then counted in other bytes.
 bool CaptureReducedRun();
 
 // Empty when the only message since the last check is one `vuid` whose text holds `text`; else what was seen.
