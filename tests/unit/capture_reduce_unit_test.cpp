@@ -1,0 +1,58 @@
+// Which devices reduce their captures on the device (capture_method, layer/capture/capture_reducer.h), and the
+// layout the host reads a reduced geometry's results in (ReducedGeometry, layer/state/capture_log.h).
+#include <catch2/catch_test_macros.hpp>
+
+#include <cstring>
+#include <vector>
+
+#include "capture_log.h"
+#include "capture_reducer.h"
+
+namespace asval {
+namespace {
+
+constexpr VkPhysicalDeviceType kGpu = VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
+constexpr VkPhysicalDeviceType kCpu = VK_PHYSICAL_DEVICE_TYPE_CPU;
+
+TEST_CASE("capture reduce unit: auto reduces on a GPU and copies on a CPU device; reduce and copy are obeyed") {
+  CHECK(CaptureReduces(kCaptureMethodAuto, kGpu, true, false, false));
+  CHECK(CaptureReduces(kCaptureMethodAuto, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU, true, false, false));
+  CHECK_FALSE(CaptureReduces(kCaptureMethodAuto, kCpu, true, false, false));
+  CHECK(CaptureReduces(kCaptureMethodReduce, kCpu, true, false, false));
+  CHECK_FALSE(CaptureReduces(kCaptureMethodCopy, kGpu, true, false, false));
+}
+
+TEST_CASE("capture reduce unit: never without bufferDeviceAddress, with shader objects or with float_spacing") {
+  for (CaptureMethod method : {kCaptureMethodAuto, kCaptureMethodReduce}) {
+    CHECK_FALSE(CaptureReduces(method, kGpu, false, false, false));
+    CHECK_FALSE(CaptureReduces(method, kGpu, true, true, false));
+    CHECK_FALSE(CaptureReduces(method, kGpu, true, false, true));
+  }
+}
+
+TEST_CASE("capture reduce unit: a reduced geometry's bytes, and its bit arrays as the host reads them") {
+  // 40 triangles: two words per array, three arrays; 120 32-bit indices; a transform.
+  CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40) == 3 * 2 * 4);
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40, 480, true) == 24 + 480 + 48);
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 1, 6, false) == 12 + 8);  // 16-bit indices: whole words
+  // 33 instances: 8 bytes of reference each, then three arrays of two words.
+  CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33) == 33 * 8 + 3 * 2 * 4);
+
+  std::vector<uint8_t> bytes(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33));
+  const uint64_t reference = 0x1234'5678'9abc'de00ull;
+  std::memcpy(bytes.data() + 8 * 32, &reference, sizeof(reference));  // instance 32's reference
+  const uint32_t active_word1 = 1u;                                    // instance 32 active
+  std::memcpy(bytes.data() + 33 * 8 + 4, &active_word1, 4);
+  const uint32_t non_finite_word0 = 1u << 5;                           // instance 5's transform
+  std::memcpy(bytes.data() + 33 * 8 + 8, &non_finite_word0, 4);
+  const ReducedGeometry reduced{bytes.data(), 33, true};
+  CHECK(reduced.Word(ReducedGeometry::kActive, 1) == 1u);
+  CHECK(reduced.Word(ReducedGeometry::kActive, 0) == 0u);
+  CHECK(reduced.Word(ReducedGeometry::kNonFinite, 0) == 1u << 5);
+  uint64_t read = 0;
+  std::memcpy(&read, reduced.references() + 8 * 32, sizeof(read));
+  CHECK(read == reference);
+}
+
+}  // namespace
+}  // namespace asval
