@@ -169,6 +169,28 @@ void CheckInstancePointers(const CheckContext& ctx, const InstanceReferenceCheck
                      DescribeOrigin(c.build), Hex(c.dst), geometry, misaligned, named));
 }
 
+// A reduced geometry's references judged by their summaries (ReducedGeometry::Distinct): true when each names a
+// live structure, `first` (when asked) then holding, per structure, the first instance referencing it (the first
+// 64-record group that holds a reference holds its first record). False when one does not: the caller walks the
+// records.
+bool JudgeDistinctReferences(const ReducedGeometry& reduced, const LiveStructureAddresses& live, uint32_t geometry,
+                             std::vector<Referenced>* first) {
+  for (uint32_t group = 0; group < (reduced.count + 63) / 64; ++group) {
+    const uint32_t distinct = std::min<uint32_t>(reduced.Distinct(group), 64);
+    for (uint32_t e = 0; e < distinct; ++e) {
+      uint64_t reference = 0;
+      uint32_t instance = 0;
+      reduced.DistinctReference(group, e, &reference, &instance);
+      const std::ptrdiff_t structure = live.Find(reference);
+      if (structure < 0) return false;
+      if (first && (*first)[static_cast<std::size_t>(structure)].structure < 0) {
+        (*first)[static_cast<std::size_t>(structure)] = Referenced{structure, geometry, instance};
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& c) {
@@ -194,6 +216,10 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       if (ctx.Enabled(kCheckAlignment)) CheckInstancePointers(ctx, c, *log, j, g);
       continue;
     }
+    // Reduced on the device: each 64 records' distinct references, with the first record of each, are judged
+    // instead of every record; only when one names no live structure are the records walked below (for the count
+    // and the instances the message names).
+    if (g.reduced && JudgeDistinctReferences(log->Reduced(g), live, j, per_structure ? &first : nullptr)) continue;
     // The records as copied, or the references alone as the layer's dispatch wrote them (CapturedGeometry::reduced).
     const uint8_t* references = log->Bytes(g.data) + (g.reduced ? 0 : kReferenceOffset);
     const VkDeviceSize stride = g.reduced ? sizeof(uint64_t) : kInstanceBytes;

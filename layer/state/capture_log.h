@@ -105,12 +105,18 @@ struct CapturedGeometry {
 // bit arrays of one bit per primitive in 32-bit words (bit t % 32 of word t / 32, zero past the count): active;
 // undefined input (triangles: a NaN Y or Z with X not NaN; AABBs: a NaN other than minX) or, for instances, a NaN
 // or infinite element in the transform; unreadable (an index naming a vertex above maxVertex, not read) or, for
-// instances, per word the first non-finite transform's (lane << 4) | element. Indexed triangles then have their
+// instances, per word the first non-finite transform's (lane << 4) | element. Instances then have, per 64 records,
+// a summary of kReducedSummaryBytes: how many distinct references other than 0 they hold (a word, padded to 16
+// bytes), then each of those once (16 bytes: the reference, the first of the 64 records holding it, padding), in no
+// particular order. Indexed triangles then have their
 // index bytes (CapturedGeometry::indices points there), rounded up to whole words, and triangles with a captured
 // transform its 48 bytes (CapturedGeometry::transform).
 inline uint32_t ReducedWords(uint32_t count) { return (count + 31) / 32; }
+inline constexpr VkDeviceSize kReducedSummaryBytes = 16 + 64 * 16;
 inline VkDeviceSize ReducedBitBytes(VkGeometryTypeKHR type, uint32_t count) {
-  return (type == VK_GEOMETRY_TYPE_INSTANCES_KHR ? 8 * VkDeviceSize{count} : 0) + 3 * 4 * VkDeviceSize{ReducedWords(count)};
+  const VkDeviceSize arrays = 3 * 4 * VkDeviceSize{ReducedWords(count)};
+  if (type != VK_GEOMETRY_TYPE_INSTANCES_KHR) return arrays;
+  return 8 * VkDeviceSize{count} + arrays + (VkDeviceSize{count} + 63) / 64 * kReducedSummaryBytes;
 }
 inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count, VkDeviceSize index_bytes, bool transform) {
   return ReducedBitBytes(type, count) + (index_bytes + 3) / 4 * 4 + (transform ? 48 : 0);
@@ -129,6 +135,23 @@ struct ReducedGeometry {
   }
   // Instances: the references.
   const uint8_t* references() const { return base; }
+  // Instances: the summary of records 64 * group .. 64 * group + 63: how many distinct references, and each.
+  uint32_t Distinct(uint32_t group) const {
+    uint32_t v;
+    std::memcpy(&v, Summary(group), sizeof(v));
+    return v;
+  }
+  void DistinctReference(uint32_t group, uint32_t entry, uint64_t* reference, uint32_t* first) const {
+    const uint8_t* e = Summary(group) + 16 + 16 * VkDeviceSize{entry};
+    std::memcpy(reference, e, sizeof(*reference));
+    std::memcpy(first, e + 8, sizeof(*first));
+  }
+
+ private:
+  const uint8_t* Summary(uint32_t group) const {
+    return base + 8 * VkDeviceSize{count} + 3 * 4 * VkDeviceSize{ReducedWords(count)} +
+           VkDeviceSize{group} * kReducedSummaryBytes;
+  }
 };
 
 // A destination of a build command that has a captured top-level info among several: what the rules about one

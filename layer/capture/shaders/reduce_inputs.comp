@@ -7,7 +7,8 @@
 //              index bytes and the transform as they are (the host hashes the indices);
 //   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
 //   instances  per record: its accelerationStructureReference, active (a reference other than 0), and whether
-//              its transform has a NaN or infinite element (per 32 records, the first such one's element too).
+//              its transform has a NaN or infinite element (per 32 records, the first such one's element too);
+//              per 64 records, each distinct reference other than 0 once, with the first record holding it.
 // Bit arrays hold one bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count. The
 // layout of the results is ReducedGeometry's (layer/state/capture_log.h).
 //
@@ -73,6 +74,9 @@ bool NonFinite32(uint bits) { return (bits & 0x7f800000u) == 0x7f800000u; }
 // This group's 64 primitives: three bit arrays of two words (instances: the third holds the first non-finite
 // transform's lane and element per word instead).
 shared uint s_bits[3][2];
+// Instances: this group's references (0: none, or inactive), and how many distinct ones it found.
+shared uvec2 s_refs[64];
+shared uint s_distinct;
 
 void main() {
   const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
@@ -97,6 +101,8 @@ void main() {
   // Uniform over the group: every invocation takes part in each round's barriers.
   for (uint group_first = gl_WorkGroupID.x * 64u; group_first < job.count; group_first += stride_x) {
     if (local < 6u) s_bits[local / 2u][local % 2u] = (job.kind == 2u && local >= 4u) ? 0xffffffffu : 0u;
+    if (local == 0u) s_distinct = 0u;
+    s_refs[local] = uvec2(0u);
     barrier();
     const uint t = group_first + local;
     bool is_active = false, undefined_input = false, unreadable = false;
@@ -151,6 +157,7 @@ void main() {
         refs.w[0] = reference.x;
         refs.w[1] = reference.y;
         is_active = reference != uvec2(0u);  // the spec's inactive instance: a reference of 0
+        s_refs[local] = reference;
         undefined_input = non_finite;        // the instances' second bit array: a non-finite transform
       }
       const uint bit = 1u << (local % 32u);
@@ -159,6 +166,26 @@ void main() {
       if (unreadable) atomicOr(s_bits[2][local / 32u], bit);
     }
     barrier();
+    // Instances: each distinct reference of these 64 records once, with the first record holding it, so that the
+    // host looks up a few references per 64 records (the records' own, all of them, stay above for messages).
+    if (job.kind == 2u && s_refs[local] != uvec2(0u)) {
+      bool first = true;
+      for (uint l = 0u; l < local; ++l) first = first && s_refs[l] != s_refs[local];
+      if (first) {
+        const uint slot = atomicAdd(s_distinct, 1u);
+        const uvec2 summary = AddProduct(Add64(AddProduct(job.out_addr, job.count, 8u), 12u * words, 0u),
+                                         group_first / 64u, 1040u);
+        OutWords entry = OutWords(AddProduct(Add64(summary, 16u, 0u), slot, 16u));
+        entry.w[0] = s_refs[local].x;
+        entry.w[1] = s_refs[local].y;
+        entry.w[2] = group_first + local;
+      }
+    }
+    barrier();
+    if (job.kind == 2u && local == 0u) {
+      OutWords(AddProduct(Add64(AddProduct(job.out_addr, job.count, 8u), 12u * words, 0u), group_first / 64u,
+                          1040u)).w[0] = s_distinct;
+    }
     const uint word = group_first / 32u + local % 2u;
     if (local < 6u && word < words) {
       // Three arrays one after the other: triangles and AABBs active, undefined, unreadable; instances (after
