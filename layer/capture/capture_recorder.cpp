@@ -7,7 +7,7 @@
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
 #include "capture_plan.h"
-#include "capture_reducer.h"
+#include "capture_reduce_jobs.h"
 #include "history.h"
 #include "structure_memory.h"
 
@@ -27,15 +27,6 @@ struct Copy {
   VkBuffer src;
   VkBuffer dst;
   VkBufferCopy region;
-};
-
-// The one reducing dispatch of a command (capture_reducer.h): its first job and how many follow it, and the X
-// groups the largest needs.
-struct Dispatch {
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  uint32_t first_job = 0;
-  uint32_t jobs = 0;
-  uint32_t groups = 0;
 };
 
 // The captures of one command, between two barriers: copies, then the reducing dispatch (after which the app's
@@ -73,63 +64,6 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
 
 void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies) {
   RecordCaptures(ctx, cb, copies, Dispatch{}, VK_NULL_HANDLE);
-}
-
-// Whether geometry g's bytes (its `data`) can be reduced on the device instead of copied: triangles, AABBs, and
-// instances given as an array of records, with strides the shader's 32-bit arithmetic holds.
-bool Reducible(const CapturedGeometry& g) {
-  const uint32_t n = g.range.primitiveCount;
-  if (n == 0) return false;
-  switch (g.type) {
-    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:  // the shader counts index bytes in 32 bits
-      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 12;
-    case VK_GEOMETRY_TYPE_AABBS_KHR:
-      return g.aabb_stride <= UINT32_MAX;
-    case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-      return !g.array_of_pointers;
-    default:
-      return false;
-  }
-}
-
-// The job reading geometry g in place: its bytes at `data` (where the copy would have started), its indices at
-// `indices` (indexed triangles) and its transform at `transform` (0: none), its results at `out`.
-ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDeviceAddress indices,
-                        VkDeviceAddress transform, VkDeviceAddress out) {
-  ReduceJob job;
-  job.count = g.range.primitiveCount;
-  job.data = data;
-  job.out = out;
-  if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
-    const VertexFormatInfo& format = VertexFormatFacts(g.vertex_format);
-    job.kind = ReduceJob::kTriangles;
-    job.stride = static_cast<uint32_t>(g.vertex_stride);
-    job.x_kind = !format.hasNaN                              ? ReduceJob::kNoNaN
-                 : format.kind == ComponentKind::Float16 ? ReduceJob::kFloat16
-                                                         : ReduceJob::kFloat32;
-    job.components = std::min<uint32_t>(format.componentCount, 3);
-    job.index_bytes = static_cast<uint32_t>(std::max(builder::IndexTypeBytes(g.index_type), 0));
-    job.first_vertex = g.range.firstVertex;
-    job.max_vertex = g.max_vertex;
-    job.indices = indices;
-    job.transform = transform;
-  } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
-    job.kind = ReduceJob::kAabbs;
-    job.stride = static_cast<uint32_t>(g.aabb_stride);
-  } else {
-    job.kind = ReduceJob::kInstances;
-    job.stride = sizeof(VkAccelerationStructureInstanceKHR);
-  }
-  return job;
-}
-
-// A bound buffer holding the whole range (the layer's shader reads it through its device address; no usage
-// beyond the SHADER_DEVICE_ADDRESS that gave the address is needed).
-std::optional<AddressHit> ReadableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
-  return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
-    std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(buffer);
-    return b && *b && (*b)->bound;
-  });
 }
 
 // The destinations of a build command of several infos, for the rules about its top-level infos' instances and
@@ -174,71 +108,6 @@ void KeepRangeFacts(const VkAccelerationStructureBuildGeometryInfoKHR& info, uin
     out->max_vertex = t.maxVertex;
   }
   out->range_facts = true;
-}
-
-// The jobs of one command's reducing dispatch: a block in the recording's log, consecutive, in a slab the
-// reducer's table holds and within its first kReduceJobsPerSlab jobs.
-struct JobBlock {
-  bool ok = false;
-  uint8_t* slots = nullptr;
-  Dispatch dispatch;
-  uint32_t capacity = 0;
-  // Room for `capacity` jobs and the pipeline; false (the command's captures are then copied) when either is
-  // missing.
-  bool Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline) {
-    CapturedBytes bytes;
-    if (pipeline == VK_NULL_HANDLE || jobs == 0 || jobs > kReduceMaxJobsPerDispatch ||
-        !log.Reserve(VkDeviceSize{jobs} * sizeof(ReduceJob) + 48, &bytes)) {  // 48: room to align to 64
-      return false;
-    }
-    const VkDeviceSize first = (bytes.offset + 63) / 64;
-    const uint32_t table_index = log.TableIndexOf(bytes);
-    if (table_index == UINT32_MAX || first + jobs > kReduceJobsPerSlab) return false;
-    slots = log.WritableBytes(bytes) + (first * 64 - bytes.offset);
-    dispatch.pipeline = pipeline;
-    dispatch.first_job = table_index << 16 | static_cast<uint32_t>(first);
-    capacity = jobs;
-    return ok = true;
-  }
-  void Add(const ReduceJob& job) {
-    std::memcpy(slots + VkDeviceSize{dispatch.jobs} * sizeof(ReduceJob), &job, sizeof(job));
-    ++dispatch.jobs;
-    const VkDeviceSize groups = (VkDeviceSize{job.count} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup;
-    dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
-  }
-};
-
-// The sources of geometry g (its data, and for triangles its indices and transform) read in place by the command's
-// dispatch: its results reserved in the log (the indices and transform among them, where the builder's views
-// find them), its job added. False when a source cannot be read (no bound buffer holds it, the transform aside)
-// or there is no room: the info is then not captured.
-bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
-                    const CaptureSource* last, JobBlock& block) {
-  const CaptureSource* data = nullptr;
-  const CaptureSource* indices = nullptr;
-  const CaptureSource* transform = nullptr;
-  for (const CaptureSource* s = first; s != last; ++s) {
-    if (s->into == &g.data) data = s;
-    if (s->into == &g.indices) indices = s;
-    if (s->into == &g.transform && ReadableBuffer(state, s->address, s->size)) transform = s;
-  }
-  if (!data || block.dispatch.jobs >= block.capacity || !ReadableBuffer(state, data->address, data->size) ||
-      (indices && !ReadableBuffer(state, indices->address, indices->size))) {
-    return false;
-  }
-  const VkDeviceSize index_bytes = indices ? indices->size : 0;
-  CapturedBytes out;
-  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) return false;
-  g.data = out;
-  const VkDeviceSize bits = ReducedBitBytes(g.type, g.range.primitiveCount);
-  if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, index_bytes, true};
-  if (transform) {
-    g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
-  }
-  g.reduced = true;
-  block.Add(MakeReduceJob(g, data->address, indices ? indices->address : 0, transform ? transform->address : 0,
-                          log.AddressOf(out)));
-  return true;
 }
 
 }  // namespace

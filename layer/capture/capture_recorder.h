@@ -2,7 +2,10 @@
 // Pre-record of a device build (execution-time capture, issue 12): decides which infos' inputs a rule needs at
 // execution time and records, through the next element of the chain and before the app's build, a barrier
 // that makes earlier writes visible to a transfer read, one copy per input range into the recording's capture
-// log, and a barrier that makes the copies visible to the host and keeps later writes behind the reads.
+// log, and a barrier that makes the copies visible to the host and keeps later writes behind the reads. Where the
+// capture reduces on the device (capture_method, capture_reducer.h), the geometries it can read in place get one
+// dispatch of the layer's per command instead of their copies (capture_reduce_jobs.h), the app's compute pipeline
+// bound again after it.
 //
 // Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
 // update's source: their activity record), updates, and every top-level build (its instance references); with

@@ -53,8 +53,8 @@ inline constexpr uint32_t kReduceSlabs = 4096;              // slabs the table h
 // than they save); never without bufferDeviceAddress (the shader reads through device addresses), with shader
 // objects enabled (binding a pipeline would unbind the app's compute shader object, which the layer does not
 // restore), or with the float_spacing warning (it needs every coordinate on the host).
-inline bool CaptureReduces(CaptureMethod method, VkPhysicalDeviceType type, bool buffer_device_address, bool shader_objects,
-                           bool float_spacing) {
+inline bool CaptureReduces(CaptureMethod method, VkPhysicalDeviceType type, bool buffer_device_address,
+                           bool shader_objects, bool float_spacing) {
   if (!buffer_device_address || shader_objects || float_spacing) return false;
   return method == kCaptureMethodReduce || (method == kCaptureMethodAuto && type != VK_PHYSICAL_DEVICE_TYPE_CPU);
 }

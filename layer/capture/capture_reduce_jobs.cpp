@@ -1,0 +1,123 @@
+#include "capture_reduce_jobs.h"
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+
+#include "asval/builder/vertex_format.h"
+#include "asval/vertex_formats.h"
+
+namespace asval {
+
+namespace {
+
+// The job reading geometry g in place: its bytes at `data` (where the copy would have started), its indices at
+// `indices` (indexed triangles) and its transform at `transform` (0: none), its results at `out`.
+ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDeviceAddress indices,
+                        VkDeviceAddress transform, VkDeviceAddress out) {
+  ReduceJob job;
+  job.count = g.range.primitiveCount;
+  job.data = data;
+  job.out = out;
+  if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    const VertexFormatInfo& format = VertexFormatFacts(g.vertex_format);
+    job.kind = ReduceJob::kTriangles;
+    job.stride = static_cast<uint32_t>(g.vertex_stride);
+    job.x_kind = !format.hasNaN                              ? ReduceJob::kNoNaN
+                 : format.kind == ComponentKind::Float16 ? ReduceJob::kFloat16
+                                                         : ReduceJob::kFloat32;
+    job.components = std::min<uint32_t>(format.componentCount, 3);
+    job.index_bytes = static_cast<uint32_t>(std::max(builder::IndexTypeBytes(g.index_type), 0));
+    job.first_vertex = g.range.firstVertex;
+    job.max_vertex = g.max_vertex;
+    job.indices = indices;
+    job.transform = transform;
+  } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
+    job.kind = ReduceJob::kAabbs;
+    job.stride = static_cast<uint32_t>(g.aabb_stride);
+  } else {
+    job.kind = ReduceJob::kInstances;
+    job.stride = sizeof(VkAccelerationStructureInstanceKHR);
+  }
+  return job;
+}
+
+// A bound buffer holding the whole range (the layer's shader reads it through its device address; no usage
+// beyond the SHADER_DEVICE_ADDRESS that gave the address is needed).
+std::optional<AddressHit> ReadableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
+  return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
+    std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(buffer);
+    return b && *b && (*b)->bound;
+  });
+}
+
+}  // namespace
+
+bool Reducible(const CapturedGeometry& g) {
+  const uint32_t n = g.range.primitiveCount;
+  if (n == 0) return false;
+  switch (g.type) {
+    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:  // the shader counts index bytes in 32 bits
+      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 12;
+    case VK_GEOMETRY_TYPE_AABBS_KHR:
+      return g.aabb_stride <= UINT32_MAX;
+    case VK_GEOMETRY_TYPE_INSTANCES_KHR:
+      return !g.array_of_pointers;
+    default:
+      return false;
+  }
+}
+
+bool JobBlock::Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline) {
+  CapturedBytes bytes;
+  if (pipeline == VK_NULL_HANDLE || jobs == 0 || jobs > kReduceMaxJobsPerDispatch ||
+      !log.Reserve(VkDeviceSize{jobs} * sizeof(ReduceJob) + 48, &bytes)) {  // 48: room to align to 64
+    return false;
+  }
+  const VkDeviceSize first = (bytes.offset + 63) / 64;
+  const uint32_t table_index = log.TableIndexOf(bytes);
+  if (table_index == UINT32_MAX || first + jobs > kReduceJobsPerSlab) return false;
+  slots = log.WritableBytes(bytes) + (first * 64 - bytes.offset);
+  dispatch.pipeline = pipeline;
+  dispatch.first_job = table_index << 16 | static_cast<uint32_t>(first);
+  capacity = jobs;
+  return ok = true;
+}
+
+void JobBlock::Add(const ReduceJob& job) {
+  std::memcpy(slots + VkDeviceSize{dispatch.jobs} * sizeof(ReduceJob), &job, sizeof(job));
+  ++dispatch.jobs;
+  const VkDeviceSize groups = (VkDeviceSize{job.count} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup;
+  dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
+}
+
+bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
+                    const CaptureSource* last, JobBlock& block) {
+  const CaptureSource* data = nullptr;
+  const CaptureSource* indices = nullptr;
+  const CaptureSource* transform = nullptr;
+  for (const CaptureSource* s = first; s != last; ++s) {
+    if (s->into == &g.data) data = s;
+    if (s->into == &g.indices) indices = s;
+    if (s->into == &g.transform && ReadableBuffer(state, s->address, s->size)) transform = s;
+  }
+  if (!data || block.dispatch.jobs >= block.capacity || !ReadableBuffer(state, data->address, data->size) ||
+      (indices && !ReadableBuffer(state, indices->address, indices->size))) {
+    return false;
+  }
+  const VkDeviceSize index_bytes = indices ? indices->size : 0;
+  CapturedBytes out;
+  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) return false;
+  g.data = out;
+  const VkDeviceSize bits = ReducedBitBytes(g.type, g.range.primitiveCount);
+  if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, index_bytes, true};
+  if (transform) {
+    g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
+  }
+  g.reduced = true;
+  block.Add(MakeReduceJob(g, data->address, indices ? indices->address : 0, transform ? transform->address : 0,
+                          log.AddressOf(out)));
+  return true;
+}
+
+}  // namespace asval

@@ -1,0 +1,50 @@
+#pragma once
+// The jobs of the capture reduced on the device (capture_method, capture_reducer.h): which geometries a build
+// command's dispatch can read in place, their jobs written into the recording's capture log, and the one dispatch
+// that runs them. Called by the recorder (capture_recorder.cpp) while it records a build's captures.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "capture_log.h"
+#include "capture_plan.h"
+#include "capture_reducer.h"
+#include "device_state.h"
+
+namespace asval {
+
+// The one reducing dispatch of a command (capture_reducer.h): its first job and how many follow it, and the X
+// groups the largest needs.
+struct Dispatch {
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  uint32_t first_job = 0;
+  uint32_t jobs = 0;
+  uint32_t groups = 0;
+};
+
+// The jobs of one command's reducing dispatch: a block in the recording's log, consecutive, in a slab the
+// reducer's table holds and within its first kReduceJobsPerSlab jobs.
+struct JobBlock {
+  bool ok = false;
+  uint8_t* slots = nullptr;
+  Dispatch dispatch;
+  uint32_t capacity = 0;
+  // Room for `capacity` jobs and the pipeline; false (the command's captures are then copied) when either is
+  // missing.
+  bool Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline);
+  void Add(const ReduceJob& job);
+};
+
+// Whether geometry g's bytes (its `data`) can be reduced on the device instead of copied: triangles, AABBs, and
+// instances given as an array of records, with strides the shader's 32-bit arithmetic holds.
+bool Reducible(const CapturedGeometry& g);
+
+// The sources of geometry g (its data, and for triangles its indices and transform; [first, last) are the
+// geometry's) read in place by the command's dispatch: its results reserved in the log (the indices and transform
+// among them, where the builder's views find them), its job added to `block`. False when a source cannot be read
+// (no bound buffer holds it, the transform aside) or there is no room: the info is then not captured.
+bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
+                    const CaptureSource* last, JobBlock& block);
+
+}  // namespace asval
