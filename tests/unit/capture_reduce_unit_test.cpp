@@ -35,8 +35,9 @@ TEST_CASE("capture reduce unit: a reduced geometry's bytes, and its bit arrays a
   CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40) == 3 * 2 * 4);
   CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40, 480, true) == 24 + 480 + 48);
   CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 1, 6, false) == 12 + 8);  // 16-bit indices: whole words
-  // 33 instances: 8 bytes of reference each, then three arrays of two words.
-  CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33) == 33 * 8 + 3 * 2 * 4);
+  // 33 instances: 8 bytes of reference each, three arrays of two words, and one summary of 64 records (a 16-byte
+  // header and 64 entries of 16 bytes).
+  CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33) == 33 * 8 + 3 * 2 * 4 + 16 + 64 * 16);
 
   std::vector<uint8_t> bytes(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33));
   const uint64_t reference = 0x1234'5678'9abc'de00ull;
@@ -52,6 +53,17 @@ TEST_CASE("capture reduce unit: a reduced geometry's bytes, and its bit arrays a
   uint64_t read = 0;
   std::memcpy(&read, reduced.references() + 8 * 32, sizeof(read));
   CHECK(read == reference);
+  // The summary of records 0..63: one distinct reference, first held by record 32.
+  const uint32_t distinct = 1, first = 32;
+  std::memcpy(bytes.data() + 33 * 8 + 24, &distinct, 4);
+  std::memcpy(bytes.data() + 33 * 8 + 24 + 16, &reference, 8);
+  std::memcpy(bytes.data() + 33 * 8 + 24 + 16 + 8, &first, 4);
+  CHECK(reduced.Distinct(0) == 1u);
+  uint64_t entry = 0;
+  uint32_t entry_first = 0;
+  reduced.DistinctReference(0, 0, &entry, &entry_first);
+  CHECK(entry == reference);
+  CHECK(entry_first == 32u);
 }
 
 }  // namespace
