@@ -3,6 +3,8 @@
 #include <dlfcn.h>
 
 #include <catch2/catch_test_macros.hpp>
+
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
