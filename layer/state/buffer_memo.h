@@ -60,13 +60,16 @@ class BufferMemo {
     }
     return HeldSlow(state, address, bytes, usage);
   }
+  // Whether `hint` names a filled entry. The bound of the array too, though count_ never exceeds it: g++ 14 cannot
+  // see that and warns (-Warray-bounds) where a caller's hint is a constant past the array.
+  bool Fresh(uint8_t hint) const { return hint < count_ && hint < entries_.size(); }
   // Holding and FindOfStructure for a lookup that recurs from call to call at the same place (pInfos[i]'s
   // scratch, its destination's buffer): `hint` is the entry that answered it last (any value at first), tried
   // before everything else and updated. Any entry that serves is a right answer (every entry is valid for the
   // maps as they are), so a stale hint only costs the usual lookup.
   [[gnu::always_inline]] bool HoldingHinted(const DeviceState& state, VkDeviceAddress address, VkDeviceSize bytes,
                                             VkBufferUsageFlags usage, uint8_t& hint, KnownBuffer* out) {
-    if (hint < count_ && Serves(entries_[hint], address, bytes, usage)) {
+    if (Fresh(hint) && Serves(entries_[hint], address, bytes, usage)) {
       *out = entries_[hint];
       return true;
     }
@@ -78,7 +81,7 @@ class BufferMemo {
   }
   bool FindOfStructureHinted(const DeviceState& state, const AccelerationStructureState& structure, uint8_t& hint,
                              KnownBuffer* out) {
-    if (hint < count_ && entries_[hint].buffer == structure.buffer) {
+    if (Fresh(hint) && entries_[hint].buffer == structure.buffer) {
       *out = entries_[hint];
       return out->id == structure.buffer_id;
     }
