@@ -66,7 +66,8 @@ VkPhysicalDevice Instance::FindRayTracingGpu() const {
   return VK_NULL_HANDLE;
 }
 
-Device::Device(const Instance& instance, VkPhysicalDevice gpu) : instance_(instance.handle()), gpu_(gpu) {
+Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptions& options)
+    : instance_(instance.handle()), gpu_(gpu) {
   uint32_t family_count = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(gpu, &family_count, nullptr);
   std::vector<VkQueueFamilyProperties> families(family_count);
@@ -96,17 +97,20 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu) : instance_(insta
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR,
       has_ray_query ? static_cast<void*>(&ray_query) : static_cast<void*>(&pipeline)};
   as_features.accelerationStructure = VK_TRUE;
+  ray_query.pNext = options.features;  // the caller's own feature structures, after these
+  pipeline.pNext = options.features;
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as_features};
   v12.bufferDeviceAddress = VK_TRUE;
-  const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
-                              has_ray_query ? VK_KHR_RAY_QUERY_EXTENSION_NAME
-                                            : VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME};
+  std::vector<const char*> extensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                         VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
+                                         has_ray_query ? VK_KHR_RAY_QUERY_EXTENSION_NAME
+                                                       : VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME};
+  extensions.insert(extensions.end(), options.extensions.begin(), options.extensions.end());
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;
-  info.enabledExtensionCount = 3;
-  info.ppEnabledExtensionNames = extensions;
+  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   Check(vkCreateDevice(gpu, &info, nullptr, &device_), "vkCreateDevice");
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
   VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};

@@ -49,9 +49,19 @@ struct AccelerationStructure {
   Buffer storage;
 };
 
+// What a Device enables beyond its own (acceleration structures, deferred host operations, ray queries or the
+// ray-tracing pipeline, bufferDeviceAddress).
+struct DeviceOptions {
+  std::vector<const char*> extensions;
+  void* features = nullptr;  // a chain of feature structures, chained after the Device's own
+};
+
+// Whether the physical device has a device extension.
+bool HasDeviceExtension(VkPhysicalDevice gpu, const char* name);
+
 class Device {
  public:
-  Device(const Instance& instance, VkPhysicalDevice gpu);
+  Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptions& options = {});
   ~Device();
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;

@@ -11,17 +11,12 @@ namespace asval {
 
 namespace {
 
-// Build flags of VK_KHR_acceleration_structure itself. Other bits belong to extensions (motion blur,
-// micromaps, newer ones) whose features and structures the size query would also need: the layer does not
-// ask about those builds.
-constexpr VkBuildAccelerationStructureFlagsKHR kCoreBuildFlags =
-    VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR |
-    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
-    VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_LOW_MEMORY_BIT_KHR;
+// Flag bits go to the size query as the app gave them, those newer than the layer's headers included
+// (ALLOW_DATA_ACCESS of VK_KHR_ray_tracing_position_fetch, the micromap bits, ...): the query takes the same info as
+// the build, and the driver that accepts the app's build knows them. Extension structures in a pNext chain do not
+// (the layer cannot compare them for its size cache): such a build's size rules are skipped and counted.
 constexpr VkBuildAccelerationStructureFlagsKHR kFastBoth =
     VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
-constexpr VkGeometryFlagsKHR kCoreGeometryFlags =
-    VK_GEOMETRY_OPAQUE_BIT_KHR | VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR;
 constexpr VkDeviceSize kMaxStride = 0xffffffffull;
 
 // Alignment unit (component size, or size of a packed format) of the acceleration-structure vertex formats
@@ -47,7 +42,7 @@ bool TrianglesQueryable(const DeviceState& state, const VkAccelerationStructureG
 bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGeometryKHR* g,
                        VkGeometryTypeKHR expected) {
   if (!g || g->sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR || g->pNext) return false;
-  if (g->geometryType != expected || (g->flags & ~kCoreGeometryFlags) != 0) return false;
+  if (g->geometryType != expected) return false;
   switch (g->geometryType) {
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
       return TrianglesQueryable(state, g->geometry.triangles);
@@ -155,7 +150,7 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
   }
   const VkAccelerationStructureBuildGeometryInfoKHR& info = *signature.info;
   if (info.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR || info.pNext) return false;
-  if ((info.flags & ~kCoreBuildFlags) != 0 || (info.flags & kFastBoth) == kFastBoth) return false;
+  if ((info.flags & kFastBoth) == kFastBoth) return false;
   if (info.geometryCount != 0 && (info.pGeometries == nullptr) == (info.ppGeometries == nullptr)) return false;
   const VkPhysicalDeviceAccelerationStructurePropertiesKHR& limits = state.properties.acceleration_structure;
   if (info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {

@@ -4,7 +4,7 @@
 
 namespace asval_test {
 
-Fixture::Fixture(const void* extra_pnext) : monitor_(std::make_unique<Monitor>()) {
+Fixture::Fixture(const void* extra_pnext, const vkkit::DeviceOptions& device) : monitor_(std::make_unique<Monitor>()) {
   pnext_info_ = monitor_->create_info();
   pnext_info_.pNext = extra_pnext;
   vkkit::InstanceOptions options;
@@ -17,7 +17,7 @@ Fixture::Fixture(const void* extra_pnext) : monitor_(std::make_unique<Monitor>()
                "vkCreateDebugUtilsMessengerEXT");
   VkPhysicalDevice gpu = instance_->FindRayTracingGpu();
   if (!gpu) throw std::runtime_error("no device with VK_KHR_acceleration_structure (is lavapipe installed?)");
-  device_ = std::make_unique<vkkit::Device>(*instance_, gpu);
+  device_ = std::make_unique<vkkit::Device>(*instance_, gpu, device);
 }
 
 Fixture::~Fixture() {

@@ -31,8 +31,9 @@ struct ApiSettings {
 
 class Fixture {
  public:
-  // extra_pnext is chained after the monitor's create info (e.g. a VkLayerSettingsCreateInfoEXT).
-  explicit Fixture(const void* extra_pnext = nullptr);
+  // extra_pnext is chained after the monitor's create info (e.g. a VkLayerSettingsCreateInfoEXT); `device` says
+  // what the device enables beyond vkkit's own.
+  explicit Fixture(const void* extra_pnext = nullptr, const vkkit::DeviceOptions& device = {});
   ~Fixture();
 
   Monitor& monitor() { return *monitor_; }

@@ -27,9 +27,9 @@ T Load(vkkit::Device& device, const char* name) {
 
 }  // namespace
 
-CheckFixture::CheckFixture(const char* families) {
+CheckFixture::CheckFixture(const char* families, const vkkit::DeviceOptions& device) {
   ApiSettings* settings = Narrowed(settings_, families);
-  fixture_ = std::make_unique<Fixture>(settings ? settings->Chain() : nullptr);
+  fixture_ = std::make_unique<Fixture>(settings ? settings->Chain() : nullptr, device);
 }
 
 const char* CommandName(Command command) {

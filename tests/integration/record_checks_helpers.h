@@ -16,7 +16,7 @@ namespace asval_test {
 // does not add its own finding; valid twins keep every family on.
 class CheckFixture {
  public:
-  explicit CheckFixture(const char* families = nullptr);
+  explicit CheckFixture(const char* families = nullptr, const vkkit::DeviceOptions& device = {});
   Monitor& monitor() { return fixture_->monitor(); }
   vkkit::Instance& instance() { return fixture_->instance(); }
   vkkit::Device& device() { return fixture_->device(); }
