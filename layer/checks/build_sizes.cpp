@@ -11,10 +11,10 @@ namespace asval {
 
 namespace {
 
-// Flag bits go to the size query as the app gave them, those newer than the layer's headers included
-// (ALLOW_DATA_ACCESS of VK_KHR_ray_tracing_position_fetch, the micromap bits, ...): the query takes the same info as
-// the build, and the driver that accepts the app's build knows them. Extension structures in a pNext chain do not
-// (the layer cannot compare them for its size cache): such a build's size rules are skipped and counted.
+// Flag bits and pNext chains go to the size query as the app gave them, those newer than the layer's headers
+// included (ALLOW_DATA_ACCESS of VK_KHR_ray_tracing_position_fetch, micromap and motion structures, ...): the query
+// takes the same info as the build, and the driver that accepts the app's build knows them. A build with a chain is
+// queried every time, never cached (BuildSignature::Cacheable: the layer cannot compare unknown structures).
 constexpr VkBuildAccelerationStructureFlagsKHR kFastBoth =
     VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
 constexpr VkDeviceSize kMaxStride = 0xffffffffull;
@@ -28,7 +28,7 @@ uint32_t VertexComponentBytes(VkFormat format) {
 }
 
 bool TrianglesQueryable(const DeviceState& state, const VkAccelerationStructureGeometryTrianglesDataKHR& t) {
-  if (t.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR || t.pNext) return false;
+  if (t.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR) return false;
   const uint32_t component = VertexComponentBytes(t.vertexFormat);
   if (component == 0 || t.vertexStride % component != 0 || t.vertexStride > kMaxStride) return false;
   if (t.indexType != VK_INDEX_TYPE_NONE_KHR && t.indexType != VK_INDEX_TYPE_UINT16 &&
@@ -41,49 +41,24 @@ bool TrianglesQueryable(const DeviceState& state, const VkAccelerationStructureG
 
 bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGeometryKHR* g,
                        VkGeometryTypeKHR expected) {
-  if (!g || g->sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR || g->pNext) return false;
+  if (!g || g->sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR) return false;
   if (g->geometryType != expected) return false;
   switch (g->geometryType) {
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
       return TrianglesQueryable(state, g->geometry.triangles);
     case VK_GEOMETRY_TYPE_AABBS_KHR: {
       const VkAccelerationStructureGeometryAabbsDataKHR& a = g->geometry.aabbs;
-      return a.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR && !a.pNext &&
+      return a.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR &&
              a.stride % 8 == 0 && a.stride <= kMaxStride;
     }
     case VK_GEOMETRY_TYPE_INSTANCES_KHR: {
       const VkAccelerationStructureGeometryInstancesDataKHR& d = g->geometry.instances;
-      return d.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR && !d.pNext &&
+      return d.sType == VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR &&
              (d.arrayOfPointers == VK_TRUE || d.arrayOfPointers == VK_FALSE);
     }
     default:
       return false;
   }
-}
-
-// Whether the info or one of its geometries carries a pNext chain (an extension's structures: micromaps, motion,
-// newer ones), which the size query does not get. Out of line: only for infos whose sizes are not known.
-[[gnu::noinline]] bool HasExtensionChain(const BuildSignature& signature) {
-  if (signature.info->pNext) return true;
-  for (uint32_t j = 0; j < signature.info->geometryCount; ++j) {
-    const VkAccelerationStructureGeometryKHR* g = signature.Geometry(j);
-    if (!g) continue;
-    if (g->pNext) return true;
-    switch (g->geometryType) {
-      case VK_GEOMETRY_TYPE_TRIANGLES_KHR:
-        if (g->geometry.triangles.pNext) return true;
-        break;
-      case VK_GEOMETRY_TYPE_AABBS_KHR:
-        if (g->geometry.aabbs.pNext) return true;
-        break;
-      case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-        if (g->geometry.instances.pNext) return true;
-        break;
-      default:
-        break;
-    }
-  }
-  return false;
 }
 
 // Out of line: walked only for infos the geometry pass flagged.
@@ -174,7 +149,7 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
     return false;
   }
   const VkAccelerationStructureBuildGeometryInfoKHR& info = *signature.info;
-  if (info.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR || info.pNext) return false;
+  if (info.sType != VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR) return false;
   if ((info.flags & kFastBoth) == kFastBoth) return false;
   if (info.geometryCount != 0 && (info.pGeometries == nullptr) == (info.ppGeometries == nullptr)) return false;
   const VkPhysicalDeviceAccelerationStructurePropertiesKHR& limits = state.properties.acceleration_structure;
@@ -209,8 +184,6 @@ std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildComma
     if (found) return sizes;
     if (SizeQueryIsValid(state, signature)) {
       if (std::optional<BuildSizes> queried = state.build_sizes.Query(signature)) return queried;
-    } else if (HasExtensionChain(signature)) {
-      state.size_rules_skipped_extension_chain.fetch_add(1, std::memory_order_relaxed);
     }
   }
   return std::nullopt;

@@ -83,14 +83,6 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
                                 capture.deserializations_restored.load(std::memory_order_relaxed),
                                 capture.deserializations_unverified.load(std::memory_order_relaxed)));
   }
-  if (const uint64_t chained = state.size_rules_skipped_extension_chain.load(std::memory_order_relaxed)) {
-    reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
-                    {Obj(VK_OBJECT_TYPE_DEVICE, device)},
-                    fmt::format("{} times a build info's size rules (destination size, scratch, aliasing) were "
-                                "skipped: the info or a geometry of it carries a pNext chain (an extension's "
-                                "structures), whose effect on the sizes the layer does not ask the driver about.",
-                                chained));
-  }
   if (skipped == 0) return;
   reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                   {Obj(VK_OBJECT_TYPE_DEVICE, device)},

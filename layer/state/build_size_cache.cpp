@@ -48,10 +48,10 @@ template <typename Sink>
         break;
       }
       case VK_GEOMETRY_TYPE_AABBS_KHR:
-        if (!emit(g->geometry.aabbs.stride)) return 0;
+        if (g->geometry.aabbs.pNext || !emit(g->geometry.aabbs.stride)) return 0;
         break;
       case VK_GEOMETRY_TYPE_INSTANCES_KHR:
-        if (!emit(g->geometry.instances.arrayOfPointers)) return 0;
+        if (g->geometry.instances.pNext || !emit(g->geometry.instances.arrayOfPointers)) return 0;
         break;
       default:
         return 0;

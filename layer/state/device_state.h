@@ -77,10 +77,6 @@ class DeviceState {
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
-  // Build infos whose size rules (destination size, scratch, aliasing) were skipped because of an extension
-  // structure in a pNext chain of the info or its geometries (the size cache cannot compare those): shown in
-  // ASVAL-History-Summary.
-  mutable std::atomic<uint64_t> size_rules_skipped_extension_chain{0};
 
   // A fresh id, unique on this device (BufferState::id).
   uint64_t NextObjectId() { return next_object_id_.fetch_add(1, std::memory_order_relaxed) + 1; }
