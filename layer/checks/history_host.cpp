@@ -83,6 +83,15 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
                                 capture.deserializations_restored.load(std::memory_order_relaxed),
                                 capture.deserializations_unverified.load(std::memory_order_relaxed)));
   }
+  if (const uint64_t unknown = state.checks_skipped_unknown_state.load(std::memory_order_relaxed)) {
+    reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
+                    {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+                    fmt::format("{} checks were skipped because the state they need was unknown (a limit the driver "
+                                "did not report, an object or command buffer the layer did not see, sizes the layer "
+                                "could not ask for, such as those of a geometry type newer than its headers, or bytes "
+                                "it could not capture): skipped, never guessed.",
+                                unknown));
+  }
   if (skipped == 0) return;
   reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                   {Obj(VK_OBJECT_TYPE_DEVICE, device)},
