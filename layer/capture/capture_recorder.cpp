@@ -6,6 +6,7 @@
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
+#include "capture_buffers.h"
 #include "capture_plan.h"
 #include "capture_reduce_jobs.h"
 #include "history.h"
@@ -14,14 +15,6 @@
 namespace asval {
 
 namespace {
-
-// The buffer a range can be copied from: bound, created copyable by the layer, holding the whole range.
-std::optional<AddressHit> CopyableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
-  return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
-    std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(buffer);
-    return b && *b && (*b)->bound && (*b)->capture_source;
-  });
-}
 
 struct Copy {
   VkBuffer src;
@@ -140,7 +133,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
     const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
     if (!within_budget) ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
     const std::optional<AddressHit> hit =
-        within_budget ? CopyableBuffer(ctx.state, addresses[i], bytes) : std::nullopt;
+        within_budget ? CaptureSourceBuffer(ctx.state, addresses[i], bytes, CaptureRead::kCopy) : std::nullopt;
     if (hit && log.Reserve(bytes, &entry.ranges)) {
       copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
                             VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
@@ -222,18 +215,15 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     reduced.assign(first_source.size() - 1, 0);
     VkDeviceSize total = 0;
     for (std::size_t j = 0; j < reduced.size(); ++j) {
-      const CapturedGeometry& g = planned[j];
-      reduced[j] = block.ok && Reducible(g);
-      VkDeviceSize index_bytes = 0;
-      bool transform = false;
-      for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
-        if (!reduced[j]) total = SaturatingAddBytes(total, sources[k].size);
-        if (sources[k].into == &g.indices) index_bytes = sources[k].size;
-        if (sources[k].into == &g.transform) transform = true;
-      }
+      reduced[j] = block.ok && Reducible(planned[j]);
       if (reduced[j]) {
-        total = SaturatingAddBytes(
-            total, ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform) + sizeof(ReduceJob));
+        const ReducedSources of = SourcesOf(planned[j], sources.data() + first_source[j],
+                                            sources.data() + first_source[j + 1]);
+        total = SaturatingAddBytes(total, ReducedCost(planned[j], of));
+        continue;
+      }
+      for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
+        total = SaturatingAddBytes(total, sources[k].size);
       }
     }
     if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
@@ -244,13 +234,14 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     const uint32_t first_job = block.dispatch.jobs;
     for (std::size_t j = 0; j < reduced.size() && entry.complete; ++j) {
       if (reduced[j]) {
-        entry.complete = ReduceGeometry(ctx.state, log, planned[j], sources.data() + first_source[j],
-                                        sources.data() + first_source[j + 1], block);
+        entry.complete = ReduceGeometry(
+            ctx.state, log, planned[j],
+            SourcesOf(planned[j], sources.data() + first_source[j], sources.data() + first_source[j + 1]), block);
         continue;
       }
       for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
         const CaptureSource& s = sources[k];
-        const std::optional<AddressHit> hit = CopyableBuffer(ctx.state, s.address, s.size);
+        const std::optional<AddressHit> hit = CaptureSourceBuffer(ctx.state, s.address, s.size, CaptureRead::kCopy);
         if (!hit && s.optional) continue;
         if (!hit || !log.Reserve(s.size, s.into)) {
           entry.complete = false;

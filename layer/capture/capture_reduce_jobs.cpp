@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
-#include <optional>
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
+#include "capture_buffers.h"
 
 namespace asval {
 
@@ -40,15 +40,6 @@ ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDevic
     job.stride = sizeof(VkAccelerationStructureInstanceKHR);
   }
   return job;
-}
-
-// A bound buffer holding the whole range (the layer's shader reads it through its device address; no usage
-// beyond the SHADER_DEVICE_ADDRESS that gave the address is needed).
-std::optional<AddressHit> ReadableBuffer(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size) {
-  return state.buffer_addresses.FindCovering(address, size, [&](VkBuffer buffer) {
-    std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(buffer);
-    return b && *b && (*b)->bound;
-  });
 }
 
 }  // namespace
@@ -91,18 +82,30 @@ void JobBlock::Add(const ReduceJob& job) {
   dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
 }
 
-bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
-                    const CaptureSource* last, JobBlock& block) {
-  const CaptureSource* data = nullptr;
-  const CaptureSource* indices = nullptr;
-  const CaptureSource* transform = nullptr;
+ReducedSources SourcesOf(const CapturedGeometry& g, const CaptureSource* first, const CaptureSource* last) {
+  ReducedSources of;
   for (const CaptureSource* s = first; s != last; ++s) {
-    if (s->into == &g.data) data = s;
-    if (s->into == &g.indices) indices = s;
-    if (s->into == &g.transform && ReadableBuffer(state, s->address, s->size)) transform = s;
+    if (s->into == &g.data) of.data = s;
+    if (s->into == &g.indices) of.indices = s;
+    if (s->into == &g.transform) of.transform = s;
   }
-  if (!data || block.dispatch.jobs >= block.capacity || !ReadableBuffer(state, data->address, data->size) ||
-      (indices && !ReadableBuffer(state, indices->address, indices->size))) {
+  return of;
+}
+
+VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& sources) {
+  return ReducedBytes(g.type, g.range.primitiveCount, sources.indices ? sources.indices->size : 0,
+                      sources.transform != nullptr) +
+         sizeof(ReduceJob);
+}
+
+bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
+                    JobBlock& block) {
+  const auto readable = [&](const CaptureSource* s) {
+    return s && CaptureSourceBuffer(state, s->address, s->size, CaptureRead::kInPlace).has_value();
+  };
+  const CaptureSource* indices = sources.indices;
+  const CaptureSource* transform = readable(sources.transform) ? sources.transform : nullptr;  // optional
+  if (!readable(sources.data) || (indices && !readable(indices)) || block.dispatch.jobs >= block.capacity) {
     return false;
   }
   const VkDeviceSize index_bytes = indices ? indices->size : 0;
@@ -115,8 +118,8 @@ bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry&
     g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
   }
   g.reduced = true;
-  block.Add(MakeReduceJob(g, data->address, indices ? indices->address : 0, transform ? transform->address : 0,
-                          log.AddressOf(out)));
+  block.Add(MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
+                          transform ? transform->address : 0, log.AddressOf(out)));
   return true;
 }
 

@@ -40,11 +40,22 @@ struct JobBlock {
 // instances given as an array of records, with strides the shader's 32-bit arithmetic holds.
 bool Reducible(const CapturedGeometry& g);
 
-// The sources of geometry g (its data, and for triangles its indices and transform; [first, last) are the
-// geometry's) read in place by the command's dispatch: its results reserved in the log (the indices and transform
-// among them, where the builder's views find them), its job added to `block`. False when a source cannot be read
-// (no bound buffer holds it, the transform aside) or there is no room: the info is then not captured.
-bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const CaptureSource* first,
-                    const CaptureSource* last, JobBlock& block);
+// Geometry g's sources among its planned ones [first, last): its data, and for triangles its indices and its
+// transform (each null when the plan has none).
+struct ReducedSources {
+  const CaptureSource* data = nullptr;
+  const CaptureSource* indices = nullptr;
+  const CaptureSource* transform = nullptr;
+};
+ReducedSources SourcesOf(const CapturedGeometry& g, const CaptureSource* first, const CaptureSource* last);
+// What reducing g costs the recording's budget: the results the dispatch writes, and its job.
+VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& sources);
+
+// Geometry g's sources read in place by the command's dispatch: its results reserved in the log (the indices and
+// transform among them, where the builder's views find them), its job added to `block`. False when a source cannot
+// be read (no bound buffer holds it; the transform is then left out instead) or there is no room: the info is then
+// not captured.
+bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
+                    JobBlock& block);
 
 }  // namespace asval

@@ -129,8 +129,7 @@ struct ReducedGeometry {
   // Word w of bit array a.
   uint32_t Word(Array a, uint32_t w) const {
     uint32_t v;
-    const VkDeviceSize arrays = instances ? 8 * VkDeviceSize{count} : 0;
-    std::memcpy(&v, base + arrays + 4 * (VkDeviceSize{a} * ReducedWords(count) + w), sizeof(v));
+    std::memcpy(&v, Arrays() + 4 * (VkDeviceSize{a} * ReducedWords(count) + w), sizeof(v));
     return v;
   }
   // Instances: the references.
@@ -148,9 +147,10 @@ struct ReducedGeometry {
   }
 
  private:
+  // The three bit arrays follow the instances' references; the summaries follow the arrays.
+  const uint8_t* Arrays() const { return base + (instances ? 8 * VkDeviceSize{count} : 0); }
   const uint8_t* Summary(uint32_t group) const {
-    return base + 8 * VkDeviceSize{count} + 3 * 4 * VkDeviceSize{ReducedWords(count)} +
-           VkDeviceSize{group} * kReducedSummaryBytes;
+    return Arrays() + 3 * 4 * VkDeviceSize{ReducedWords(count)} + VkDeviceSize{group} * kReducedSummaryBytes;
   }
 };
 

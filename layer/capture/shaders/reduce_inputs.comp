@@ -168,13 +168,13 @@ void main() {
     barrier();
     // Instances: each distinct reference of these 64 records once, with the first record holding it, so that the
     // host looks up a few references per 64 records (the records' own, all of them, stay above for messages).
+    const uvec2 summary =
+        AddProduct(Add64(AddProduct(job.out_addr, job.count, 8u), 12u * words, 0u), group_first / 64u, 1040u);
     if (job.kind == 2u && s_refs[local] != uvec2(0u)) {
       bool first = true;
       for (uint l = 0u; l < local; ++l) first = first && s_refs[l] != s_refs[local];
       if (first) {
         const uint slot = atomicAdd(s_distinct, 1u);
-        const uvec2 summary = AddProduct(Add64(AddProduct(job.out_addr, job.count, 8u), 12u * words, 0u),
-                                         group_first / 64u, 1040u);
         OutWords entry = OutWords(AddProduct(Add64(summary, 16u, 0u), slot, 16u));
         entry.w[0] = s_refs[local].x;
         entry.w[1] = s_refs[local].y;
@@ -182,10 +182,7 @@ void main() {
       }
     }
     barrier();
-    if (job.kind == 2u && local == 0u) {
-      OutWords(AddProduct(Add64(AddProduct(job.out_addr, job.count, 8u), 12u * words, 0u), group_first / 64u,
-                          1040u)).w[0] = s_distinct;
-    }
+    if (job.kind == 2u && local == 0u) OutWords(summary).w[0] = s_distinct;
     const uint word = group_first / 32u + local % 2u;
     if (local < 6u && word < words) {
       // Three arrays one after the other: triangles and AABBs active, undefined, unreadable; instances (after
