@@ -147,7 +147,11 @@ class Enumerant:
 
 def registry_version(registry_dir):
     """'1.3.239' from vk.xml's VK_HEADER_VERSION and VK_HEADER_VERSION_COMPLETE defines; None when absent."""
-    root = ET.parse(os.path.join(registry_dir, 'vk.xml')).getroot()
+    return version_of(ET.parse(os.path.join(registry_dir, 'vk.xml')).getroot())
+
+
+def version_of(root):
+    """registry_version of an already parsed vk.xml."""
     patch, major_minor = None, None
     for t in root.iter('type'):
         name = t.find('name')
@@ -168,8 +172,8 @@ def registry_version(registry_dir):
 class Registry:
     def __init__(self, registry_dir):
         self.dir = registry_dir
-        self.version = registry_version(registry_dir)
         root = ET.parse(os.path.join(registry_dir, 'vk.xml')).getroot()
+        self.version = version_of(root)
         self.commands = {}                        # canonical name -> Command
         self.command_alias_of = {}                # alias name -> the name it aliases (may itself be an alias)
         self.required_commands = set()            # every command name the headers declare
