@@ -101,6 +101,7 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptio
   pipeline.pNext = options.features;
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as_features};
   v12.bufferDeviceAddress = VK_TRUE;
+  v12.hostQueryReset = VK_TRUE;  // vkResetQueryPool, as programs that compact their structures use it
   std::vector<const char*> extensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
                                          VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
                                          has_ray_query ? VK_KHR_RAY_QUERY_EXTENSION_NAME

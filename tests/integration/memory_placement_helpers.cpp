@@ -84,6 +84,11 @@ void SharedMemory::DestroyBuffer(vkkit::Buffer& buffer) {
   buffer = vkkit::Buffer{};
 }
 
+void SharedMemory::DestroyStructure(VkAccelerationStructureKHR structure) {
+  structures_.erase(std::remove(structures_.begin(), structures_.end(), structure), structures_.end());
+  device_.DestroyAccelerationStructureKHR(device_.handle(), structure, nullptr);
+}
+
 VkAccelerationStructureBuildSizesInfoKHR DriverSizes(vkkit::Device& device,
                                                      const VkAccelerationStructureBuildGeometryInfoKHR& info,
                                                      const std::vector<uint32_t>& counts) {

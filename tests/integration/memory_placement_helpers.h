@@ -25,6 +25,7 @@ class SharedMemory {
   VkAccelerationStructureKHR Structure(const vkkit::Buffer& buffer, VkDeviceSize offset, VkDeviceSize size,
                                        VkAccelerationStructureTypeKHR type);
   void DestroyBuffer(vkkit::Buffer& buffer);  // early, e.g. to reuse its addresses
+  void DestroyStructure(VkAccelerationStructureKHR structure);  // early, before its buffer
   VkDeviceMemory memory() const { return memory_; }
 
  private:

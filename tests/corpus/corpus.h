@@ -1,0 +1,37 @@
+#pragma once
+// The accuracy corpus: small programs, each one case of what ray-tracing programs do with acceleration
+// structures, labelled with the VUIDs a validation layer must report for it (none for a valid program).
+// `asval_corpus --list` prints the labels; `asval_corpus CASE` runs one case in this process under whatever
+// layers ASVAL_TEST_LAYERS names (run_corpus.py runs each case in its own process, under asval and under the
+// Khronos layer, and compares). Cases are written against the Vulkan API only: nothing in them knows asval.
+#include <string>
+#include <vector>
+
+#include "vkkit.h"
+
+namespace corpus {
+
+using CaseBody = void (*)(vkkit::Device& device);
+
+struct Case {
+  const char* name;     // unique, kebab-case
+  const char* family;   // the rule family it exercises (asval's families; "patterns" for whole-program patterns)
+  const char* pattern;  // what the program does, in one sentence
+  std::vector<std::string> expected;  // the VUIDs it must trigger, newest spelling; empty: valid, must stay silent
+  CaseBody body;
+};
+
+// Every case of the program, in registration order.
+std::vector<Case>& Cases();
+
+struct Registrar {
+  explicit Registrar(Case c) { Cases().push_back(std::move(c)); }
+};
+
+}  // namespace corpus
+
+// CORPUS_CASE(function, "name", "family", "pattern", {"VUID-...", ...}) { body using `device` }
+#define CORPUS_CASE(function, name, family, pattern, ...)                                          \
+  static void function(vkkit::Device& device);                                                       \
+  static const corpus::Registrar function##_registrar({name, family, pattern, __VA_ARGS__, &function}); \
+  static void function([[maybe_unused]] vkkit::Device& device)

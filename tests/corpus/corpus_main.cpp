@@ -1,0 +1,119 @@
+// asval_corpus: `--list` prints every case's label as JSON; `CASE` runs that case and prints each validation
+// message it receives as one JSON line, then {"done": true}. A line-per-message protocol survives a crash of
+// the process half-way (an invalid call that no layer stopped may bring the driver down): what was reported
+// before is kept.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <string>
+
+#include "corpus.h"
+
+namespace corpus {
+
+std::vector<Case>& Cases() {
+  static std::vector<Case> cases;
+  return cases;
+}
+
+namespace {
+
+std::string Json(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+void List() {
+  std::printf("[\n");
+  const std::vector<Case>& cases = Cases();
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    std::string expected;
+    for (const std::string& vuid : c.expected) expected += (expected.empty() ? "" : ", ") + Json(vuid);
+    std::printf("  {\"name\": %s, \"family\": %s, \"pattern\": %s, \"expected\": [%s]}%s\n", Json(c.name).c_str(),
+                Json(c.family).c_str(), Json(c.pattern).c_str(), expected.c_str(), i + 1 < cases.size() ? "," : "");
+  }
+  std::printf("]\n");
+}
+
+// Errors return VK_TRUE: whichever layer reports the fault keeps the call from the driver, as an app that stops
+// on validation errors would (both layers honour it).
+VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  const bool error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  std::string text = data->pMessage ? data->pMessage : "";
+  if (text.size() > 400) text.resize(400);
+  std::printf("{\"severity\": \"%s\", \"id\": %s, \"text\": %s}\n", error ? "error" : "warning",
+              Json(data->pMessageIdName ? data->pMessageIdName : "").c_str(), Json(text).c_str());
+  std::fflush(stdout);
+  return error ? VK_TRUE : VK_FALSE;
+}
+
+int Run(const Case& c) {
+  VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  messenger_info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+  messenger_info.pfnUserCallback = &Print;
+  vkkit::InstanceOptions options;
+  options.layers = vkkit::LayersFromEnvironment();
+  options.pNext = &messenger_info;  // messages of instance creation and destruction
+  vkkit::Instance instance(options);
+  auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance.handle(), "vkCreateDebugUtilsMessengerEXT"));
+  auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance.handle(), "vkDestroyDebugUtilsMessengerEXT"));
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  vkkit::Check(create(instance.handle(), &messenger_info, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
+  VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  if (!gpu) {
+    std::fprintf(stderr, "asval_corpus: no device with VK_KHR_acceleration_structure\n");
+    return 2;
+  }
+  {
+    vkkit::Device device(instance, gpu);
+    c.body(device);
+  }  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too
+  destroy(instance.handle(), messenger, nullptr);
+  return 0;
+}
+
+}  // namespace
+}  // namespace corpus
+
+int main(int argc, char** argv) {
+  if (argc != 2 || std::strcmp(argv[1], "--help") == 0) {
+    std::fprintf(stderr, "usage: asval_corpus --list | CASE\n");
+    return argc == 2 ? 0 : 2;
+  }
+  if (std::strcmp(argv[1], "--list") == 0) {
+    corpus::List();
+    return 0;
+  }
+  for (const corpus::Case& c : corpus::Cases()) {
+    if (c.name != std::string(argv[1])) continue;
+    try {
+      const int status = corpus::Run(c);
+      if (status == 0) std::printf("{\"done\": true}\n");
+      return status;
+    } catch (const std::exception& e) {
+      std::printf("{\"exception\": %s}\n", corpus::Json(e.what()).c_str());
+      return 3;
+    }
+  }
+  std::fprintf(stderr, "asval_corpus: no case '%s' (see --list)\n", argv[1]);
+  return 2;
+}

@@ -1,0 +1,276 @@
+#!/usr/bin/env python3
+"""Runs the accuracy corpus under asval and under the Khronos validation layer, and compares.
+
+Each case runs in its own process: the corpus program's cases (asval_corpus --list) and the sample scene's
+faults (asval_scene --list-faults). A case is labelled with the VUIDs it must trigger; a valid case must
+trigger nothing. Per configuration (a layer and its settings) the runner counts, per rule family:
+  detected / expected   labelled VUIDs reported (a layer may use an older name of the same rule: the aliases
+                        of scripts/vuids_newer.json count), over all fault cases
+  false positives       valid cases with any error
+and prints one table. asval's own configuration is held to the labels exactly: every labelled VUID reported,
+no other error in a fault case, no error or warning in a valid case. With --verdicts, every configuration's
+verdicts are compared with the committed ones (the Khronos layer's only when its version is the one recorded);
+any change fails the run. --update-verdicts rewrites that file instead: a reviewed step, like a new baseline.
+
+Extra configurations: --config NAME:ENV=VALUE,ENV=VALUE (asval with those settings), reported beside.
+Exit status: 0 all well, 1 a verdict differs from the labels or the committed verdicts.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+ALIASES_FILE = os.path.join(ROOT, "scripts", "vuids_newer.json")
+KHRONOS_MANIFEST_DIR = "/usr/share/vulkan/explicit_layer.d"
+ASVAL = "VK_LAYER_ASVAL_as_validation"
+KHRONOS = "VK_LAYER_KHRONOS_validation"
+LVP_ICD = "/usr/share/vulkan/icd.d/lvp_icd.json"
+TIMEOUT_S = 120
+
+
+def khronos_version():
+    try:
+        for name in os.listdir(KHRONOS_MANIFEST_DIR):
+            with open(os.path.join(KHRONOS_MANIFEST_DIR, name)) as f:
+                layer = json.load(f).get("layer", {})
+            if layer.get("name") == KHRONOS:
+                return layer.get("api_version", "unknown")
+    except OSError:
+        pass
+    return None
+
+
+def load_aliases():
+    with open(ALIASES_FILE) as f:
+        return json.load(f).get("aliases", {})
+
+
+def list_cases(corpus, scene):
+    cases = []
+    out = subprocess.run([corpus, "--list"], stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
+    for c in json.loads(out):
+        c["command"] = [corpus, c["name"]]
+        cases.append(c)
+    if scene:
+        out = subprocess.run([scene, "--list-faults"], stdout=subprocess.PIPE, universal_newlines=True,
+                             check=True).stdout
+        for line in out.splitlines():
+            if not line.strip() or line.startswith("#"):
+                continue
+            name, vuid = line.split()[:2]
+            cases.append({"name": "scene-" + name, "family": "scene", "expected": [vuid],
+                          "pattern": "the sample scene, 2 frames, then the fault " + name,
+                          "command": [scene, "--frames", "2", "--instances", "500", "--inject", name]})
+        cases.append({"name": "scene-clean", "family": "scene", "expected": [],
+                      "pattern": "the sample scene, 4 frames: refits, TLAS updates and rebuilds, tracing",
+                      "command": [scene, "--frames", "4", "--instances", "500"]})
+    return cases
+
+
+def configurations(layer_path, extra):
+    base = {
+        "VK_LAYER_PATH": layer_path + ":" + KHRONOS_MANIFEST_DIR,
+        "VK_DRIVER_FILES": LVP_ICD,
+        "VK_LOADER_LAYERS_DISABLE": "~implicit~",
+        "VK_LAYER_SETTINGS_PATH": "/nonexistent/vk_layer_settings.txt",  # default settings for every layer
+    }
+    configs = {
+        "asval": dict(base, ASVAL_TEST_LAYERS=ASVAL, VK_INSTANCE_LAYERS=ASVAL),
+        "khronos": dict(base, ASVAL_TEST_LAYERS=KHRONOS, VK_INSTANCE_LAYERS=KHRONOS),
+    }
+    for spec in extra:
+        name, _, settings = spec.partition(":")
+        env = dict(configs["asval"])
+        for pair in filter(None, settings.split(",")):
+            key, _, value = pair.partition("=")
+            env[key] = value
+        configs[name] = env
+    return configs
+
+
+# Scene lines "finding: error VUID"; corpus lines are JSON.
+SCENE_FINDING = re.compile(r"^finding: (error|warning) (\S+)")
+
+
+def run_case(case, env):
+    full_env = dict(os.environ)
+    for key in ("VK_INSTANCE_LAYERS", "ASVAL_TEST_LAYERS", "VK_ADD_LAYER_PATH"):
+        full_env.pop(key, None)
+    full_env.update(env)
+    errors, warnings, status = [], [], "done"
+    with tempfile.TemporaryDirectory() as cwd:  # no vk_layer_settings.txt of a working directory applies
+        try:
+            proc = subprocess.run(case["command"], env=full_env, cwd=cwd, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, universal_newlines=True, errors="replace",
+                                  timeout=TIMEOUT_S)
+            output, code = proc.stdout, proc.returncode
+        except subprocess.TimeoutExpired as e:
+            output, code = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (
+                e.stdout or ""), None
+            status = "timeout"
+    finished = False
+    for line in output.splitlines():
+        m = SCENE_FINDING.match(line)
+        if m:
+            (errors if m.group(1) == "error" else warnings).append(m.group(2))
+            continue
+        if not line.startswith("{"):
+            continue
+        try:
+            msg = json.loads(line)
+        except ValueError:
+            continue
+        if "severity" in msg:
+            (errors if msg["severity"] == "error" else warnings).append(msg["id"] or "(no id)")
+        elif msg.get("done"):
+            finished = True
+        elif "exception" in msg:
+            status = "exception: " + msg["exception"]
+    if status == "done":
+        is_scene = case["family"] == "scene"
+        if code != 0 or (not is_scene and not finished):
+            status = "crashed (exit %s)" % code
+    return {"status": status, "errors": sorted(set(errors)), "warnings": sorted(set(warnings)),
+            "output": output[-3000:] if status != "done" else ""}
+
+
+def judge(case, result, aliases):
+    names = {v: {v, *aliases.get(v, [])} for v in case["expected"]}
+    reported = set(result["errors"])
+    detected = [v for v in case["expected"] if names[v] & reported]
+    known = set().union(*names.values()) if names else set()
+    result["detected"] = detected
+    result["missed"] = [v for v in case["expected"] if v not in detected]
+    result["extra"] = sorted(reported - known)
+    return result
+
+
+def exact(case, result):
+    """asval's own standard: the labels exactly."""
+    if result["status"] != "done" or result["missed"] or result["extra"]:
+        return False
+    return bool(case["expected"]) or not result["warnings"]
+
+
+def verdict(result):
+    """What --verdicts compares: what was reported of the labels, and what else."""
+    return {"status": result["status"].split(" ")[0], "detected": result["detected"], "extra": result["extra"]}
+
+
+def table(cases, configs):
+    families = sorted({c["family"] for c in cases})
+    header = ["family", "faults", "valid"]
+    for name in configs:
+        header += [name + " detected", name + " FP"]
+    rows = [header]
+    totals = [0, 0] + [[0, 0, 0] for _ in configs]
+    for family in families + ["total"]:
+        sel = [c for c in cases if family in ("total", c["family"])]
+        faults = [c for c in sel if c["expected"]]
+        row = [family, str(len(faults)), str(len(sel) - len(faults))]
+        for name in configs:
+            expected = sum(len(c["expected"]) for c in faults)
+            detected = sum(len(c["results"][name]["detected"]) for c in faults)
+            fps = sum(1 for c in sel if not c["expected"] and c["results"][name]["errors"])
+            row += ["%d/%d" % (detected, expected), str(fps)]
+        rows.append(row)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
+    return "\n".join("  ".join(cell.ljust(w) for cell, w in zip(r, widths)) for r in rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", required=True, help="the asval_corpus program")
+    ap.add_argument("--scene", help="the asval_scene program (its faults join the corpus)")
+    ap.add_argument("--layer-path", required=True, help="the folder holding asval's layer manifest")
+    ap.add_argument("--config", action="append", default=[], help="NAME:ENV=VALUE,... an extra asval configuration")
+    ap.add_argument("--no-khronos", action="store_true", help="leave the Khronos layer out")
+    ap.add_argument("--cases", help="only the cases whose name contains this")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
+    ap.add_argument("--json", help="write every result here")
+    ap.add_argument("--verdicts", help="the committed verdicts to compare with")
+    ap.add_argument("--update-verdicts", action="store_true", help="rewrite --verdicts from this run")
+    args = ap.parse_args()
+
+    aliases = load_aliases()
+    cases = list_cases(os.path.abspath(args.corpus), args.scene and os.path.abspath(args.scene))
+    if args.cases:
+        cases = [c for c in cases if args.cases in c["name"]]
+    configs = configurations(os.path.abspath(args.layer_path), args.config)
+    kversion = khronos_version()
+    if args.no_khronos or not kversion:
+        del configs["khronos"]
+        if not args.no_khronos:
+            print("note: the Khronos validation layer is not installed; its column is left out")
+
+    jobs = [(c, name) for c in cases for name in configs]
+    for c in cases:
+        c["results"] = {}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        futures = {pool.submit(run_case, c, configs[name]): (c, name) for c, name in jobs}
+        for future in concurrent.futures.as_completed(futures):
+            c, name = futures[future]
+            c["results"][name] = judge(c, future.result(), aliases)
+
+    problems = []
+    for c in cases:
+        r = c["results"]["asval"]
+        if not exact(c, r):
+            problems.append("asval on %s: expected %s; reported errors %s, warnings %s, status %s%s" % (
+                c["name"], c["expected"] or "silence", r["errors"], r["warnings"], r["status"],
+                ("\n" + r["output"]) if r["output"] else ""))
+    print("corpus: %d cases (%d faults, %d valid), Khronos layer %s" % (
+        len(cases), sum(1 for c in cases if c["expected"]), sum(1 for c in cases if not c["expected"]),
+        kversion or "absent"))
+    print(table(cases, configs))
+    for c in cases:  # what the other layers missed or got wrong, for the reader
+        for name in configs:
+            r = c["results"][name]
+            if name != "asval" and (r["missed"] or (not c["expected"] and r["errors"])):
+                print("  %s on %s: missed %s, errors %s, status %s" % (name, c["name"], r["missed"], r["errors"],
+                                                                        r["status"]))
+
+    if args.verdicts:
+        current = {"khronos_version": kversion,
+                   "verdicts": {name: {c["name"]: verdict(c["results"][name]) for c in cases} for name in configs}}
+        if args.update_verdicts:
+            with open(args.verdicts, "w") as f:
+                json.dump(current, f, indent=1, sort_keys=True)
+                f.write("\n")
+            print("wrote " + args.verdicts)
+        elif os.path.exists(args.verdicts):
+            with open(args.verdicts) as f:
+                committed = json.load(f)
+            for name, verdicts in current["verdicts"].items():
+                if name == "khronos" and committed.get("khronos_version") != kversion:
+                    print("note: Khronos layer %s, verdicts committed for %s: not compared" % (
+                        kversion, committed.get("khronos_version")))
+                    continue
+                before = committed["verdicts"].get(name)
+                if before is None:
+                    continue
+                if args.cases:
+                    before = {k: v for k, v in before.items() if k in verdicts}
+                for case in sorted(set(before) | set(verdicts)):
+                    if before.get(case) != verdicts.get(case):
+                        problems.append("verdict changed, %s on %s: committed %s, now %s" % (
+                            name, case, before.get(case), verdicts.get(case)))
+        else:
+            problems.append("no committed verdicts at %s (run with --update-verdicts)" % args.verdicts)
+
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"khronos_version": kversion, "configs": list(configs), "cases": cases}, f, indent=1)
+    for p in problems:
+        print("FAIL: " + p)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
