@@ -1,0 +1,403 @@
+#!/usr/bin/env python3
+"""Writes docs/comparison.md (and its plot): what asval catches and what it costs, beside the Khronos layer.
+
+Runs, on this machine, in one go:
+  1. the accuracy corpus (tests/corpus/run_corpus.py) under the Khronos layer and under asval at each capture
+     setting and with each rule family switched off;
+  2. the overhead benchmark (bench/overhead/run_overhead.py) under the same configurations (all rows for the
+     main ones, the cheap rows and the scene for the others);
+then writes the feature table by family, the overhead table and the run time against error view (a table and
+docs/comparison.png). Every figure in the document comes from these two runs; the document says where it ran.
+
+Usage: scripts/comparison.py [--build build] [--out docs/comparison.md] [--rounds 5]
+         [--corpus-json F] [--overhead-json F]   reuse earlier runs instead of running them (their JSON is kept
+                                                  beside the document as comparison-corpus.json and
+                                                  comparison-overhead.json)
+Needs python3-matplotlib for the plot (Debian's; the script re-runs itself under /usr/bin/python3 when the python3
+on PATH lacks it).
+"""
+import argparse
+import datetime
+import glob
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FAMILIES = ["features", "handles", "structure", "alignment", "addresses", "aliasing", "host", "copies", "history"]
+ENV_PREFIX = "VK_ASVAL_AS_VALIDATION_"
+KHRONOS_SO = "/usr/lib/x86_64-linux-gnu/libVkLayer_khronos_validation.so"
+# The configurations of the run time against error view: capture settings, then each family switched off.
+CAPTURE_CONFIGS = {
+    "asval-capture-off": ENV_PREFIX + "CAPTURE=off",
+    "asval-capture-all": ENV_PREFIX + "CAPTURE=all",
+}
+FAMILY_CONFIGS = {"asval-no-" + f: ENV_PREFIX + "ENABLED_CHECKS=" + ",".join(x for x in FAMILIES if x != f)
+                  for f in FAMILIES}
+# The rows measured for every configuration of the view (the others run only for none, asval and khronos).
+VIEW_ROWS = ["build 1x1", "submit 1000 builds+updates", "scene dynamic"]
+
+
+def ensure_matplotlib():
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        if sys.executable != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
+            os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+        sys.exit("comparison.py: needs python3-matplotlib (apt-get install python3-matplotlib)")
+
+
+def sh(cmd):
+    return subprocess.run(cmd, shell=True, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                          universal_newlines=True).stdout.strip()
+
+
+def machine():
+    cpu = sh("sed -n 's/^model name[^:]*: //p' /proc/cpuinfo | head -1")
+    os_name = sh(". /etc/os-release && echo $PRETTY_NAME")
+    driver = sh("VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.json vulkaninfo --summary 2>/dev/null | "
+                "sed -n 's/^\\s*driverInfo *= //p' | head -1")
+    return {
+        "cpu": cpu, "cores": os.cpu_count(), "os": os_name, "kernel": platform.release(),
+        "compiler": sh("c++ --version | head -1"),
+        "driver": "lavapipe " + driver if driver else "unknown",
+        "loader": sh("dpkg-query -W -f='${Version}' libvulkan1"),
+        "khronos_layer": sh("dpkg-query -W -f='${Version}' vulkan-validationlayers"),
+        "asval": sh("git -C %s rev-parse --short HEAD" % ROOT),
+    }
+
+
+def registry():
+    """scripts/checks: every VUID of each family with its status."""
+    vuids = {}
+    for path in sorted(glob.glob(os.path.join(ROOT, "scripts", "checks", "*.json"))):
+        with open(path) as f:
+            for entry in json.load(f):
+                vuids[entry["vuid"]] = entry
+    return vuids
+
+
+def khronos_named(vuids):
+    """The registry's VUIDs (or an older name of theirs) that the Khronos layer's binary contains: an upper bound
+    of what it checks, since a message id must be in the binary to be reported."""
+    if not os.path.exists(KHRONOS_SO):
+        return set()
+    text = sh("strings %s | grep -o 'VUID-[A-Za-z0-9_]*-[A-Za-z0-9_]*-[0-9]*' | sort -u" % KHRONOS_SO)
+    present = set(text.split())
+    with open(os.path.join(ROOT, "scripts", "vuids_newer.json")) as f:
+        aliases = json.load(f).get("aliases", {})
+    return {v for v in vuids if present & {v, *aliases.get(v, [])}}
+
+
+def run_corpus(build, out):
+    configs = dict(CAPTURE_CONFIGS, **FAMILY_CONFIGS)
+    cmd = [sys.executable, os.path.join(ROOT, "tests", "corpus", "run_corpus.py"),
+           "--corpus", os.path.join(build, "tests", "corpus", "asval_corpus"),
+           "--scene", os.path.join(build, "examples", "scene", "asval_scene"),
+           "--layer-path", os.path.join(build, "layer"), "--json", out]
+    for name, env in configs.items():
+        cmd += ["--config", "%s:%s" % (name, env)]
+    print("+ " + " ".join(cmd), flush=True)
+    subprocess.run(cmd)  # exit 1 only says a verdict differs from the committed ones: the figures stand
+    return " ".join(os.path.relpath(c, ROOT) if c.startswith(ROOT) else c for c in cmd[1:])
+
+
+def run_overhead(build, out, rounds):
+    script = os.path.join(ROOT, "bench", "overhead", "run_overhead.py")
+    main = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--out", out]
+    print("+ " + " ".join(main), flush=True)
+    subprocess.run(main, check=True)
+    view = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--out", out + ".view",
+            "--only-configs", "--rows", ",".join(VIEW_ROWS)]
+    for name, env in dict(CAPTURE_CONFIGS, **FAMILY_CONFIGS).items():
+        view += ["--config", "%s:%s" % (name, env)]
+    print("+ " + " ".join(view), flush=True)
+    subprocess.run(view, check=True)
+    with open(out) as f:
+        merged = json.load(f)
+    with open(out + ".view") as f:
+        extra = json.load(f)
+    seen = {(r["row"], r["config"]) for r in merged["rows"]}
+    merged["rows"] += [r for r in extra["rows"] if (r["row"], r["config"]) not in seen]
+    merged["command_view"] = extra.get("command")
+    with open(out, "w") as f:
+        json.dump(merged, f, indent=1)
+    os.remove(out + ".view")
+    return "%s; %s" % (" ".join(main[1:]), " ".join(view[1:]))
+
+
+def md_table(header, rows):
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def corpus_counts(cases, config, family=None):
+    sel = [c for c in cases if family in (None, c["family"]) and config in c["results"]]
+    faults = [c for c in sel if c["expected"]]
+    expected = sum(len(c["expected"]) for c in faults)
+    detected = sum(len(c["results"][config]["detected"]) for c in faults)
+    fps = sum(1 for c in sel if not c["expected"] and c["results"][config]["errors"])
+    valid = len(sel) - len(faults)
+    return detected, expected, fps, valid
+
+
+def feature_table(vuids, named, cases):
+    rows = []
+    families = FAMILIES + sorted({c["family"] for c in cases} - set(FAMILIES))
+    for family in families:
+        entries = [e for e in vuids.values() if e["family"] == family]
+        checked = [e["vuid"] for e in entries if e["status"] in ("checked", "partial")]
+        full = sum(1 for e in entries if e["status"] == "checked")
+        k_named = sum(1 for v in checked if v in named)
+        corpus_vuids = {v for c in cases if c["family"] == family for v in c["expected"]}
+        a = corpus_counts(cases, "asval", family)
+        k = corpus_counts(cases, "khronos", family)
+        rows.append([family, "%d (%d partial)" % (len(checked), len(checked) - full) if entries else "-",
+                     "%d of %d" % (k_named, len(checked)) if entries else "-", len(corpus_vuids),
+                     "%d / %d" % (a[0], a[1]), "%d of %d" % (a[2], a[3]),
+                     "%d / %d" % (k[0], k[1]), "%d of %d" % (k[2], k[3])])
+    return md_table(["family", "asval checks (VUIDs)", "named in the Khronos layer", "corpus VUIDs",
+                     "asval detected", "asval false positives (valid cases)", "Khronos detected",
+                     "Khronos false positives (valid cases)"], rows)
+
+
+def overhead_lookup(overhead):
+    return {(r["row"], r["config"]): r for r in overhead["rows"]}
+
+
+def fmt_ns(ns):
+    if ns is None:
+        return "-"
+    if ns >= 1e6:
+        return "%.2f ms" % (ns / 1e6)
+    if ns >= 1e3:
+        return "%.1f µs" % (ns / 1e3)
+    return "%.0f ns" % ns
+
+
+def overhead_table(overhead):
+    look = overhead_lookup(overhead)
+    rows_order = []
+    for r in overhead["rows"]:
+        if r["row"] not in rows_order and r["config"] in ("none", "asval"):
+            rows_order.append(r["row"])
+    configs = [c for c in ["none", "asval", "asval-capture-off", "asval-capture-all", "khronos"]
+               if any(k[1] == c for k in look)]
+    out = []
+    for row in rows_order:
+        base = look.get((row, "none"))
+        cells = [row]
+        for config in configs:
+            r = look.get((row, config))
+            if not r:
+                cells.append("-")
+                continue
+            cell = "%s / %s" % (fmt_ns(r["wall_ns_min"]), fmt_ns(r["wall_ns_median"]))
+            if r.get("ir_per_call") is not None:
+                cell += ", %s Ir" % format(int(r["ir_per_call"]), ",")
+            if base and config != "none" and base["wall_ns_median"]:
+                cell += " (%+.0f%%)" % (100.0 * (r["wall_ns_median"] / base["wall_ns_median"] - 1))
+            cells.append(cell)
+        a, k = look.get((row, "asval")), look.get((row, "khronos"))
+        ratio = "-"
+        if base and a and k and a.get("ir_per_call") is not None and k.get("ir_per_call") is not None:
+            added_a = a["ir_per_call"] - base["ir_per_call"]
+            added_k = k["ir_per_call"] - base["ir_per_call"]
+            if added_k > 0:
+                ratio = "%.2f" % (added_a / added_k)
+        cells.append(ratio)
+        out.append(cells)
+    return md_table(["row"] + configs + ["asval added Ir / Khronos added Ir"], out)
+
+
+def added_percent(look, row, config):
+    base, r = look.get((row, "none")), look.get((row, config))
+    if not base or not r or not base["wall_ns_median"]:
+        return None
+    return 100.0 * (r["wall_ns_median"] / base["wall_ns_median"] - 1)
+
+
+def added_ir(look, row, config):
+    base, r = look.get((row, "none")), look.get((row, config))
+    if not base or not r or base.get("ir_per_call") is None or r.get("ir_per_call") is None:
+        return None
+    return r["ir_per_call"] - base["ir_per_call"]
+
+
+def view_points(cases, overhead):
+    look = overhead_lookup(overhead)
+    configs = ["asval"] + list(CAPTURE_CONFIGS) + list(FAMILY_CONFIGS) + ["khronos"]
+    points = []
+    for config in configs:
+        if not any(config in c["results"] for c in cases):
+            continue
+        detected, expected, _, _ = corpus_counts(cases, config)
+        missed = sorted({c["name"] for c in cases if c["expected"] and config in c["results"]
+                         and c["results"][config]["missed"]})
+        points.append({"config": config, "detected": detected, "expected": expected, "missed": missed,
+                       "scene": added_percent(look, "scene dynamic", config),
+                       "build_ir": added_ir(look, "build 1x1", config),
+                       "submit_ir": added_ir(look, "submit 1000 builds+updates", config)})
+    return points
+
+
+def view_table(points):
+    rows = []
+    for p in points:
+        missed = ", ".join(p["missed"][:6]) + (" and %d more" % (len(p["missed"]) - 6) if len(p["missed"]) > 6 else "")
+        rows.append([p["config"], "-" if p["scene"] is None else "%+.1f%%" % p["scene"],
+                     "-" if p["build_ir"] is None else format(int(p["build_ir"]), ","),
+                     "-" if p["submit_ir"] is None else format(int(p["submit_ir"]), ","),
+                     "%d / %d" % (p["detected"], p["expected"]), p["expected"] - p["detected"], missed or "-"])
+    return md_table(["configuration", "dynamic scene frame time", "added Ir per build call (1x1)",
+                     "added Ir per submission of 1000 operations", "corpus detected", "faults missed",
+                     "cases with a miss"], rows)
+
+
+def plot(points, path, title):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    for p in points:
+        if p["scene"] is None:
+            continue
+        missed = p["expected"] - p["detected"]
+        khronos = p["config"] == "khronos"
+        ax.scatter([p["scene"]], [missed], marker="s" if khronos else "o", s=60,
+                   color="tab:red" if khronos else ("tab:blue" if p["config"] == "asval" else "tab:gray"))
+        ax.annotate(p["config"].replace("asval-", ""), (p["scene"], missed), textcoords="offset points",
+                    xytext=(5, 4), fontsize=8)
+    ax.set_xlabel("added frame time, dynamic sample scene (% over no layer, median)")
+    ax.set_ylabel("corpus faults missed (labelled VUIDs not reported)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "comparison.md"))
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--corpus-json")
+    ap.add_argument("--overhead-json")
+    args = ap.parse_args()
+    ensure_matplotlib()
+    build = os.path.abspath(args.build)
+    docs = os.path.dirname(os.path.abspath(args.out))
+    os.makedirs(docs, exist_ok=True)
+    corpus_json = os.path.join(docs, "comparison-corpus.json")
+    overhead_json = os.path.join(docs, "comparison-overhead.json")
+    commands = {}
+    if args.corpus_json:
+        if os.path.abspath(args.corpus_json) != corpus_json:
+            with open(args.corpus_json) as f, open(corpus_json, "w") as g:
+                g.write(f.read())
+        commands["corpus"] = "(reused: %s)" % args.corpus_json
+    else:
+        commands["corpus"] = run_corpus(build, corpus_json)
+    if args.overhead_json:
+        if os.path.abspath(args.overhead_json) != overhead_json:
+            with open(args.overhead_json) as f, open(overhead_json, "w") as g:
+                g.write(f.read())
+        commands["overhead"] = "(reused: %s)" % args.overhead_json
+    else:
+        commands["overhead"] = run_overhead(build, overhead_json, args.rounds)
+    with open(corpus_json) as f:
+        corpus = json.load(f)
+    with open(overhead_json) as f:
+        overhead = json.load(f)
+    cases = corpus["cases"]
+    # The corpus JSON is kept small: results only, not the runs' output tails.
+    for c in cases:
+        for r in c["results"].values():
+            r.pop("output", None)
+    with open(corpus_json, "w") as f:
+        json.dump(corpus, f, indent=1)
+
+    vuids = registry()
+    named = khronos_named(vuids)
+    m = overhead.get("machine") or machine()
+    points = view_points(cases, overhead)
+    png = os.path.splitext(args.out)[0] + ".png"
+    title = "asval (each capture setting, each family off) and the Khronos layer %s on %s" % (
+        corpus.get("khronos_version") or "", m.get("driver", ""))
+    plot(points, png, title)
+    a = corpus_counts(cases, "asval")
+    k = corpus_counts(cases, "khronos")
+    doc = ["# asval beside the Khronos validation layer: what each catches, what each costs",
+           "",
+           "Generated by `scripts/comparison.py` on %s; do not edit by hand. Both layers ran on the same programs, "
+           "the Khronos layer stacked alone with default settings (the installed package), asval alone with "
+           "default settings unless a configuration says otherwise." % datetime.date.today().isoformat(),
+           "",
+           "Machine: %s, %s cores; %s; %s; driver %s; Vulkan loader %s; Khronos validation layer %s; compiler %s; "
+           "asval %s." % (m.get("cpu"), m.get("cores"), m.get("os"), m.get("kernel", ""), m.get("driver"),
+                          m.get("loader"), m.get("khronos_layer"), m.get("compiler"), m.get("asval", machine()["asval"])),
+           "",
+           "Commands: corpus `%s`; overhead `%s`." % (commands["corpus"], commands["overhead"]),
+           "Raw results: [comparison-corpus.json](comparison-corpus.json), "
+           "[comparison-overhead.json](comparison-overhead.json).",
+           "",
+           "## In one line",
+           "",
+           "Corpus of %d programs (%d with a fault, %d valid): asval reports %d of %d labelled VUIDs with %d false "
+           "positives; the Khronos layer %d of %d with %d false positives." % (
+               len(cases), sum(1 for c in cases if c["expected"]), sum(1 for c in cases if not c["expected"]),
+               a[0], a[1], a[2], k[0], k[1], k[2]),
+           "",
+           "## What each layer checks, by rule family",
+           "",
+           "*asval checks*: VUIDs of the family in the check registry (`scripts/checks`, status checked or partial). "
+           "*Named in the Khronos layer*: how many of those VUIDs (under any of their names) occur in the Khronos "
+           "layer's binary, an upper bound of what it checks. *Corpus*: the labelled VUIDs of the family's fault "
+           "cases that each layer reported (detected / labelled) and the valid cases it reported an error on. "
+           "Family `scene`: the sample scene's faults; `patterns`: whole-program valid patterns.",
+           "",
+           feature_table(vuids, named, cases),
+           "",
+           "## Overhead",
+           "",
+           "Per call (per cycle, per submission, per frame): wall time min / median over interleaved rounds, "
+           "instructions per call under callgrind, and the median's change against no layer. Ratios are computed "
+           "within this run.",
+           "",
+           overhead_table(overhead),
+           "",
+           "## Run time against error",
+           "",
+           "What asval costs at each setting against what it then misses in the corpus; the Khronos layer as a "
+           "point of its own.",
+           "",
+           "![run time against error](%s)" % os.path.basename(png),
+           "",
+           view_table(points),
+           "",
+           "## Where the Khronos layer differs",
+           "",
+           ]
+    diffs = []
+    for c in cases:
+        r = c["results"].get("khronos")
+        if r is None:
+            continue
+        if c["expected"] and r["missed"]:
+            diffs.append("- `%s` (%s): misses %s%s" % (c["name"], c["family"], ", ".join(r["missed"]),
+                                                       "" if r["status"] == "done" else "; the run ended: " + r["status"]))
+        if not c["expected"] and r["errors"]:
+            diffs.append("- `%s` (valid): reports %s" % (c["name"], ", ".join(r["errors"])))
+    doc += diffs or ["(none)"]
+    doc.append("")
+    with open(args.out, "w") as f:
+        f.write("\n".join(doc))
+    print("wrote %s and %s" % (args.out, png))
+
+
+if __name__ == "__main__":
+    main()
