@@ -1,0 +1,411 @@
+// Family "history", the rules decided on the bytes a build reads when it EXECUTES: an update may not change which
+// primitives are active (pInfos-03663, 03664) nor the index values (pInfos-03768) of its source's last build, and a
+// top-level build's instances may reference only live structures (pInfos-06707). The data is written the way
+// programs write it: on the host into mapped buffers after the command buffer was recorded, or on the device by
+// vkCmdCopyBuffer / vkCmdUpdateBuffer in front of the refit, so that the fault exists only in the bytes at execution
+// time (what the buffers held when the command was recorded, or submitted, is valid). Every case waits for its
+// submissions: that is when the bytes are known.
+//
+// A triangle is inactive when the X of one of its vertices is NaN, an AABB when its minimum X is NaN, an instance
+// when its accelerationStructureReference is 0. A "destroyed" bottom-level structure is one whose handle was
+// destroyed while the buffer it lived in (a pool) stays: lavapipe reads the referenced structures when it builds,
+// so the stale address always names allocated bytes.
+#include <cstddef>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "capture_helpers.h"
+#include "corpus.h"
+#include "history_helpers.h"
+
+namespace {
+
+using asval_test::Blas;
+using asval_test::Commands;
+using asval_test::Inputs;
+using asval_test::Shape;
+using asval_test::Tlas;
+
+constexpr auto kBuild = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+constexpr auto kUpdate = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+constexpr VkBufferUsageFlags kInputUsage =
+    VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);
+constexpr VkDeviceSize kReferenceOffset = offsetof(VkAccelerationStructureInstanceKHR, accelerationStructureReference);
+
+// Six vertices (two unit right triangles at z = 0 and z = 1), moved by dx along X: what a simulation writes.
+std::vector<float> Positions(float dx) {
+  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  std::vector<float> xyz;
+  for (uint32_t v = 0; v < 6; ++v) {
+    xyz.push_back(corner[v % 3][0] + dx);
+    xyz.push_back(corner[v % 3][1]);
+    xyz.push_back(static_cast<float>(v / 3));
+  }
+  return xyz;
+}
+
+Shape TwoTriangles(VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR) {
+  Shape s;
+  s.triangles = 2;
+  s.index_type = index_type;
+  return s;
+}
+
+Shape TwoBoxes() {
+  Shape s = TwoTriangles();
+  s.geometry_type = VK_GEOMETRY_TYPE_AABBS_KHR;
+  return s;
+}
+
+// A host-visible staging buffer the app fills on the host and copies from on the device.
+struct Staging {
+  Staging(vkkit::Device& d, VkDeviceSize size) : device(d) {
+    buffer = device.CreateBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  }
+  ~Staging() { device.Destroy(buffer); }
+  template <typename T>
+  void Fill(const std::vector<T>& values) {
+    std::memcpy(buffer.mapped, values.data(), values.size() * sizeof(T));
+  }
+  // vkCmdCopyBuffer of `size` bytes from the start of the staging buffer to `offset` of `dst`.
+  void CopyTo(VkCommandBuffer cb, VkBuffer dst, VkDeviceSize offset, VkDeviceSize size) const {
+    const VkBufferCopy region{0, offset, size};
+    vkCmdCopyBuffer(cb, buffer.buffer, dst, 1, &region);
+  }
+  vkkit::Device& device;
+  vkkit::Buffer buffer;
+};
+
+// The mapped inputs, written on the host (the vertices of Positions(0) are already there).
+void HostWriteFloat(const Inputs& inputs, VkDeviceSize offset, float value) {
+  std::memcpy(static_cast<unsigned char*>(inputs.buffer().mapped) + offset, &value, sizeof value);
+}
+
+// Byte offset of component c of vertex v in the inputs (R32G32B32_SFLOAT, tightly packed).
+VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + 12 * v + 4 * c; }
+
+// One frame's refit: the staging bytes copied over the inputs at `offset`, made visible to the build, the refit.
+void CopyAndRefit(vkkit::Device& device, Blas& blas, const Inputs& inputs, const Staging& staging, VkDeviceSize offset,
+                  VkDeviceSize size, const Shape& shape) {
+  device.OneShot([&](VkCommandBuffer cb) {
+    staging.CopyTo(cb, inputs.buffer().buffer, offset, size);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, shape);
+  });
+}
+
+// ---- bottom-level refits -------------------------------------------------------------------------------------
+
+CORPUS_CASE(RefitCopyMakesTriangleInactive, "capture-refit-copy-makes-triangle-inactive", "history",
+            "a deforming BLAS refitted every frame from positions copied by vkCmdCopyBuffer; in frame 3 the positions "
+            "culls a triangle with a NaN X, which the BLAS build had active",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  for (int frame = 1; frame <= 3; ++frame) {
+    std::vector<float> positions = Positions(0.25f * frame);
+    if (frame == 3) positions[3 * 4] = kNan;  // triangle 1's second vertex
+    staging.Fill(positions);
+    CopyAndRefit(device, blas, inputs, staging, Inputs::kVerticesOffset, 6 * 12, TwoTriangles());
+  }
+}
+
+CORPUS_CASE(RefitCopyMovesVertices, "capture-refit-copy-moves-vertices", "history",
+            "a deforming BLAS refitted every frame from positions copied by vkCmdCopyBuffer, every triangle active "
+            "throughout",
+            {}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  for (int frame = 1; frame <= 4; ++frame) {
+    staging.Fill(Positions(0.25f * frame));
+    CopyAndRefit(device, blas, inputs, staging, Inputs::kVerticesOffset, 6 * 12, TwoTriangles());
+  }
+}
+
+CORPUS_CASE(RefitUpdateBufferRevivesTriangle, "capture-refit-update-buffer-revives-triangle", "history",
+            "a BLAS built with triangle 1 inactive (NaN X written on the host); a vkCmdUpdateBuffer in front of the "
+            "refit writes a finite X there",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03663"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  HostWriteFloat(inputs, Component(3, 0), kNan);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  device.OneShot([&](VkCommandBuffer cb) {
+    const float x = 0.0f;
+    vkCmdUpdateBuffer(cb, inputs.buffer().buffer, Component(3, 0), sizeof x, &x);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, TwoTriangles());
+  });
+}
+
+CORPUS_CASE(InactiveTriangleStaysInactive, "capture-inactive-triangle-stays-inactive", "history",
+            "a BLAS built with triangle 1 inactive; every frame's copied positions move the active triangle and keep "
+            "a NaN X (another vertex, another NaN) in triangle 1",
+            {}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  HostWriteFloat(inputs, Component(3, 0), kNan);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  for (int frame = 1; frame <= 3; ++frame) {
+    std::vector<float> positions = Positions(0.5f * frame);
+    positions[3 * (3 + frame % 3)] = frame % 2 ? -kNan : kNan;
+    staging.Fill(positions);
+    CopyAndRefit(device, blas, inputs, staging, Inputs::kVerticesOffset, 6 * 12, TwoTriangles());
+  }
+}
+
+CORPUS_CASE(DegenerateTriangleStaysActive, "capture-degenerate-triangle-stays-active", "history",
+            "a refit whose copied positions collapse triangle 1 to a point (degenerate, still active), and the next "
+            "refit restores it",
+            {}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  std::vector<float> collapsed = Positions(0);
+  for (uint32_t v = 4; v < 6; ++v) {
+    for (uint32_t c = 0; c < 3; ++c) collapsed[3 * v + c] = collapsed[3 * 3 + c];
+  }
+  staging.Fill(collapsed);
+  CopyAndRefit(device, blas, inputs, staging, Inputs::kVerticesOffset, 6 * 12, TwoTriangles());
+  staging.Fill(Positions(0));
+  CopyAndRefit(device, blas, inputs, staging, Inputs::kVerticesOffset, 6 * 12, TwoTriangles());
+}
+
+CORPUS_CASE(ResubmittedRefitHostNan, "capture-resubmitted-refit-host-writes-nan", "history",
+            "one refit command buffer recorded once and resubmitted every frame after the host writes new positions "
+            "into the mapped vertex buffer; frame 3's positions hold a NaN X in triangle 0",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  VkCommandBuffer refit = commands.Begin();
+  blas.Update(refit, TwoTriangles());
+  commands.End(refit);
+  for (int frame = 1; frame <= 3; ++frame) {
+    std::vector<float> positions = Positions(0.25f * frame);
+    if (frame == 3) positions[3 * 1] = kNan;
+    std::memcpy(inputs.buffer().mapped, positions.data(), positions.size() * sizeof(float));
+    commands.Submit(refit);
+  }
+}
+
+CORPUS_CASE(RefitCopyChangesIndices, "capture-refit-copy-changes-indices", "history",
+            "an indexed BLAS (UINT32) refitted after a vkCmdCopyBuffer that rewrites its index buffer with other "
+            "values (triangle 0 becomes 0, 1, 3)",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03768"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles(VK_INDEX_TYPE_UINT32)); });
+  Staging staging(device, 6 * 4);
+  staging.Fill(std::vector<uint32_t>{0, 1, 3, 3, 4, 5});
+  CopyAndRefit(device, blas, inputs, staging, Inputs::kIndicesOffset, 6 * 4, TwoTriangles(VK_INDEX_TYPE_UINT32));
+}
+
+CORPUS_CASE(RefitCopySameIndices, "capture-refit-rewrites-same-indices", "history",
+            "an indexed BLAS (UINT16) whose index and vertex buffers are both rewritten by copies before each refit: "
+            "the index values stay the same",
+            {}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  const std::vector<uint16_t> indices = {0, 1, 2, 3, 4, 5};
+  std::memcpy(static_cast<unsigned char*>(inputs.buffer().mapped) + Inputs::kIndicesOffset, indices.data(),
+              indices.size() * sizeof(uint16_t));
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles(VK_INDEX_TYPE_UINT16)); });
+  Staging index_staging(device, 6 * 2);
+  index_staging.Fill(indices);
+  Staging vertex_staging(device, 6 * 12);
+  for (int frame = 1; frame <= 2; ++frame) {
+    vertex_staging.Fill(Positions(-0.5f * frame));
+    device.OneShot([&](VkCommandBuffer cb) {
+      index_staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kIndicesOffset, 6 * 2);
+      vertex_staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+      asval_test::InputsWritten(cb);
+      blas.Update(cb, TwoTriangles(VK_INDEX_TYPE_UINT16));
+    });
+  }
+}
+
+CORPUS_CASE(AabbRefitCopyNan, "capture-aabb-refit-copy-makes-box-inactive", "history",
+            "a procedural (AABB) BLAS refitted from boxes copied by vkCmdCopyBuffer; the copied boxes give box 1 a "
+            "NaN minimum X",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoBoxes()); });
+  Staging staging(device, 2 * 24);
+  staging.Fill(std::vector<float>{0.5f, 0, 0, 1.5f, 1, 1, kNan, 0, 0, 3.5f, 1, 1});
+  CopyAndRefit(device, blas, inputs, staging, Inputs::kAabbsOffset, 2 * 24, TwoBoxes());
+}
+
+// ---- top-level builds and updates ----------------------------------------------------------------------------
+
+VkAccelerationStructureInstanceKHR Instance(VkDeviceAddress reference, uint32_t i, float dx = 0) {
+  VkAccelerationStructureInstanceKHR instance{};
+  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
+  instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f + dx;
+  instance.mask = 0xff;
+  instance.accelerationStructureReference = reference;
+  return instance;
+}
+
+// Two built BLASes, a TLAS and its instance buffer (host-mapped, also a transfer destination).
+struct Scene {
+  explicit Scene(vkkit::Device& d) : device(d), inputs(d), a(d, inputs), b(d, inputs), tlas(d) {
+    instances = device.CreateBuffer(4 * kInstanceBytes, kInputUsage);
+    std::memset(instances.mapped, 0, 4 * kInstanceBytes);
+    device.OneShot([&](VkCommandBuffer cb) {
+      a.Build(cb, Shape{});
+      b.Build(cb, Shape{});
+    });
+  }
+  ~Scene() { device.Destroy(instances); }
+  void HostWrite(const std::vector<VkAccelerationStructureInstanceKHR>& records) {
+    std::memcpy(instances.mapped, records.data(), records.size() * kInstanceBytes);
+  }
+  void WriteReference(VkCommandBuffer cb, uint32_t i, VkDeviceAddress reference) {
+    vkCmdUpdateBuffer(cb, instances.buffer, i * kInstanceBytes + kReferenceOffset, sizeof reference, &reference);
+  }
+  void Record(VkCommandBuffer cb, uint32_t count, VkBuildAccelerationStructureModeKHR mode) {
+    asval_test::InputsWritten(cb);
+    tlas.Record(cb, instances, count, mode);
+  }
+  vkkit::Device& device;
+  Inputs inputs;
+  Blas a, b;
+  Tlas tlas;
+  vkkit::Buffer instances;
+};
+
+CORPUS_CASE(TlasUpdateHostActivates, "capture-tlas-update-host-write-activates-instance", "history",
+            "a TLAS built with instance 1 hidden (reference 0); the per-frame update command buffer, recorded once, "
+            "is submitted after the host wrote BLAS b's address into instance 1",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03663"}) {
+  Scene scene(device);
+  Commands commands(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(0, 1)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kBuild); });
+  VkCommandBuffer update = commands.Begin();
+  scene.Record(update, 2, kUpdate);
+  commands.End(update);
+  scene.HostWrite({Instance(scene.a.address(), 0, 0.5f), Instance(0, 1, 0.5f)});
+  commands.Submit(update);
+  scene.HostWrite({Instance(scene.a.address(), 0, 1.0f), Instance(scene.b.address(), 1, 1.0f)});
+  commands.Submit(update);
+}
+
+CORPUS_CASE(TlasUpdateDeviceDeactivates, "capture-tlas-update-device-write-hides-instance", "history",
+            "a TLAS over two BLASes; a vkCmdUpdateBuffer in front of the TLAS update sets instance 1's reference to 0",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Scene scene(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kBuild); });
+  device.OneShot([&](VkCommandBuffer cb) {
+    scene.WriteReference(cb, 1, 0);
+    scene.Record(cb, 2, kUpdate);
+  });
+}
+
+CORPUS_CASE(TlasRebuildChangesActivity, "capture-tlas-rebuild-hides-instance-then-updates", "history",
+            "a TLAS over two BLASes; instance 1 hidden (reference 0 by vkCmdUpdateBuffer) and the TLAS rebuilt, not "
+            "updated; the following updates keep it hidden while moving instance 0",
+            {}) {
+  Scene scene(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kBuild); });
+  device.OneShot([&](VkCommandBuffer cb) {
+    scene.WriteReference(cb, 1, 0);
+    scene.Record(cb, 2, kBuild);
+  });
+  for (int frame = 1; frame <= 2; ++frame) {
+    scene.HostWrite({Instance(scene.a.address(), 0, 0.5f * frame), Instance(0, 1, 0.5f * frame)});
+    device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kUpdate); });
+  }
+}
+
+CORPUS_CASE(TlasReferencesDestroyedBlas, "capture-tlas-rebuild-references-destroyed-blas", "history",
+            "a TLAS rebuilt every frame by one command buffer; after frame 1 BLAS b is destroyed (its pool buffer "
+            "stays) but its instance is left in the mapped instance buffer",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-06707"}) {
+  Scene scene(device);
+  Commands commands(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  VkCommandBuffer rebuild = commands.Begin();
+  scene.Record(rebuild, 2, kBuild);
+  commands.End(rebuild);
+  commands.Submit(rebuild);
+  scene.b.DestroyHandle();
+  commands.Submit(rebuild);
+}
+
+CORPUS_CASE(TlasStagingCopyDestroyedBlas, "capture-tlas-instances-copied-after-blas-destroyed", "history",
+            "the TLAS instances staged on the host while BLAS b lived, b destroyed, then the staging copied into the "
+            "instance buffer by vkCmdCopyBuffer in front of the TLAS build",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-06707"}) {
+  Scene scene(device);
+  Staging staging(device, 2 * kInstanceBytes);
+  staging.Fill(std::vector<VkAccelerationStructureInstanceKHR>{Instance(scene.a.address(), 0),
+                                                               Instance(scene.b.address(), 1)});
+  scene.b.DestroyHandle();
+  device.OneShot([&](VkCommandBuffer cb) {
+    staging.CopyTo(cb, scene.instances.buffer, 0, 2 * kInstanceBytes);
+    scene.Record(cb, 2, kBuild);
+  });
+}
+
+CORPUS_CASE(TlasBlasRecreatedSameAddress, "capture-tlas-blas-recreated-at-same-address", "history",
+            "BLAS b destroyed and created again in the same pool buffer and offset (the same device address), rebuilt; "
+            "the TLAS command buffer recorded before is resubmitted with the unchanged instances",
+            {}) {
+  Scene scene(device);
+  Commands commands(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  VkCommandBuffer rebuild = commands.Begin();
+  scene.Record(rebuild, 2, kBuild);
+  commands.End(rebuild);
+  commands.Submit(rebuild);
+  scene.b.Recreate();
+  device.OneShot([&](VkCommandBuffer cb) { scene.b.Build(cb, Shape{}); });
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  commands.Submit(rebuild);
+}
+
+CORPUS_CASE(TlasStaleBeyondCount, "capture-tlas-stale-record-beyond-instance-count", "history",
+            "an instance buffer holding, past the instance count the TLAS build reads, a record of a destroyed BLAS",
+            {}) {
+  Scene scene(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  scene.b.DestroyHandle();
+  const VkDeviceAddress live = scene.a.address();
+  device.OneShot([&](VkCommandBuffer cb) {
+    vkCmdUpdateBuffer(cb, scene.instances.buffer, kReferenceOffset, sizeof live, &live);
+    scene.Record(cb, 1, kBuild);
+  });
+}
+
+CORPUS_CASE(TlasRemovesDestroyedBlas, "capture-tlas-hides-instance-before-blas-destroyed", "history",
+            "BLAS b destroyed after the TLAS build that referenced it completed; the next frames hide its instance "
+            "(reference 0 by vkCmdUpdateBuffer) and rebuild the TLAS",
+            {}) {
+  Scene scene(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kBuild); });
+  scene.b.DestroyHandle();
+  for (int frame = 1; frame <= 2; ++frame) {
+    device.OneShot([&](VkCommandBuffer cb) {
+      scene.WriteReference(cb, 1, 0);
+      scene.Record(cb, 2, kBuild);
+    });
+  }
+}
+
+}  // namespace
