@@ -247,6 +247,122 @@ CORPUS_CASE(AabbRefitCopyNan, "capture-aabb-refit-copy-makes-box-inactive", "his
   CopyAndRefit(device, blas, inputs, staging, Inputs::kAabbsOffset, 2 * 24, TwoBoxes());
 }
 
+CORPUS_CASE(RefitInSecondaryCopyNan, "capture-refit-in-secondary-copy-makes-triangle-inactive", "history",
+            "a secondary command buffer copies the frame's positions (with a NaN X in triangle 0) and refits the BLAS; "
+            "a primary executes it",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  std::vector<float> positions = Positions(0.5f);
+  positions[3 * 2] = kNan;
+  staging.Fill(positions);
+  VkCommandBuffer secondary = commands.BeginSecondary();
+  staging.CopyTo(secondary, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+  asval_test::InputsWritten(secondary);
+  blas.Update(secondary, TwoTriangles());
+  commands.End(secondary);
+  VkCommandBuffer primary = commands.Begin();
+  vkCmdExecuteCommands(primary, 1, &secondary);
+  commands.End(primary);
+  commands.Submit(primary);
+}
+
+// In one command buffer: the build, the barriers that let the next copy overwrite what the build read and the refit
+// read what the build wrote, the copy of the next positions, the refit.
+void BuildCopyRefit(vkkit::Device& device, const std::vector<float>& next) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Staging staging(device, 6 * 12);
+  staging.Fill(next);
+  device.OneShot([&](VkCommandBuffer cb) {
+    blas.Build(cb, TwoTriangles());
+    commands.Barrier(cb);
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         0, nullptr, 0, nullptr, 0, nullptr);
+    staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, TwoTriangles());
+  });
+}
+
+CORPUS_CASE(BuildAndRefitOneCommandBufferNan, "capture-build-and-refit-in-one-command-buffer-nan", "history",
+            "one command buffer builds the BLAS, copies new positions over its vertices (a NaN X in triangle 1) and "
+            "refits it: the build and the refit read different bytes",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  std::vector<float> next = Positions(1.0f);
+  next[3 * 5] = kNan;
+  BuildCopyRefit(device, next);
+}
+
+CORPUS_CASE(BuildAndRefitOneCommandBuffer, "capture-build-and-refit-in-one-command-buffer", "history",
+            "one command buffer builds the BLAS, copies moved positions over its vertices and refits it", {}) {
+  BuildCopyRefit(device, Positions(1.0f));
+}
+
+CORPUS_CASE(RefitIntoOtherNan, "capture-refit-into-another-structure-nan", "history",
+            "a refit from BLAS a into BLAS b after a vkCmdUpdateBuffer wrote a NaN X into a vertex of triangle 1, "
+            "active in a's build",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas a(device, inputs), b(device, inputs);
+  device.OneShot([&](VkCommandBuffer cb) { a.Build(cb, TwoTriangles()); });
+  device.OneShot([&](VkCommandBuffer cb) {
+    vkCmdUpdateBuffer(cb, inputs.buffer().buffer, Component(4, 0), sizeof kNan, &kNan);
+    asval_test::InputsWritten(cb);
+    b.Update(cb, TwoTriangles(), &a);
+  });
+}
+
+// A BLAS of one triangle (maxVertex with room for two), serialized into device memory of the size read back,
+// deserialized into another structure; `refit` then refits that copy.
+void SerializeDeserializeRefit(vkkit::Device& device, const Shape& refit) {
+  Inputs inputs(device);
+  Blas original(device, inputs), restored(device, inputs);
+  Commands commands(device);
+  Shape built;
+  built.max_vertex = 5;
+  asval_test::QueryPool pool(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, 1);
+  device.OneShot([&](VkCommandBuffer cb) {
+    pool.Reset(cb);
+    original.Build(cb, built);
+    commands.Barrier(cb);
+    asval_test::CmdWriteProperties(device, cb, {original.handle()},
+                                   VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, pool.handle(), 0);
+  });
+  vkkit::Buffer blob = device.CreateBuffer(pool.Results()[0], VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  device.OneShot([&](VkCommandBuffer cb) { asval_test::CmdSerialize(device, cb, original.handle(), blob.address); });
+  device.OneShot([&](VkCommandBuffer cb) { asval_test::CmdDeserialize(device, cb, blob.address, restored.handle()); });
+  VkCommandBuffer update = commands.Begin();
+  restored.Update(update, refit);
+  commands.End(update);
+  commands.Submit(update);
+  device.Destroy(blob);
+}
+
+CORPUS_CASE(DeserializedRefitMorePrimitives, "capture-deserialized-copy-refit-more-primitives", "history",
+            "a 1-triangle BLAS serialized to device memory and deserialized into another structure (a cache round "
+            "trip); the copy is refitted with 2 triangles",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-primitiveCount-03769"}) {
+  Shape two;
+  two.max_vertex = 5;
+  two.triangles = 2;
+  SerializeDeserializeRefit(device, two);
+}
+
+CORPUS_CASE(DeserializedRefit, "capture-deserialized-copy-refit", "history",
+            "a 1-triangle BLAS serialized to device memory and deserialized into another structure; the copy is "
+            "refitted with the original's parameters",
+            {}) {
+  Shape one;
+  one.max_vertex = 5;
+  SerializeDeserializeRefit(device, one);
+}
+
 // ---- top-level builds and updates ----------------------------------------------------------------------------
 
 VkAccelerationStructureInstanceKHR Instance(VkDeviceAddress reference, uint32_t i, float dx = 0) {
@@ -406,6 +522,66 @@ CORPUS_CASE(TlasRemovesDestroyedBlas, "capture-tlas-hides-instance-before-blas-d
       scene.Record(cb, 2, kBuild);
     });
   }
+}
+
+CORPUS_CASE(TlasSecondaryDestroyedBlas, "capture-tlas-build-in-secondary-references-destroyed-blas", "history",
+            "a secondary command buffer recorded while BLAS b lived writes the instances (vkCmdUpdateBuffer) and builds "
+            "the TLAS; b is destroyed before the primary executing it is submitted",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-06707"}) {
+  Scene scene(device);
+  Commands commands(device);
+  const std::vector<VkAccelerationStructureInstanceKHR> records = {Instance(scene.a.address(), 0),
+                                                                   Instance(scene.b.address(), 1)};
+  VkCommandBuffer secondary = commands.BeginSecondary();
+  vkCmdUpdateBuffer(secondary, scene.instances.buffer, 0, 2 * kInstanceBytes, records.data());
+  scene.Record(secondary, 2, kBuild);
+  commands.End(secondary);
+  VkCommandBuffer primary = commands.Begin();
+  vkCmdExecuteCommands(primary, 1, &secondary);
+  commands.End(primary);
+  scene.b.DestroyHandle();
+  commands.Submit(primary);
+}
+
+CORPUS_CASE(TlasUpdateMovesInstances, "capture-tlas-update-changes-transforms-masks", "history",
+            "a TLAS with a hidden instance updated every frame from host-written records: transforms, masks and "
+            "custom indices change, each instance's reference stays (0 stays 0)",
+            {}) {
+  Scene scene(device);
+  Commands commands(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(0, 1), Instance(scene.b.address(), 2)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 3, kBuild); });
+  VkCommandBuffer update = commands.Begin();
+  scene.Record(update, 3, kUpdate);
+  commands.End(update);
+  for (uint32_t frame = 1; frame <= 3; ++frame) {
+    VkAccelerationStructureInstanceKHR first = Instance(scene.a.address(), 0, 0.5f * frame);
+    first.mask = static_cast<uint32_t>(0xff >> frame);
+    first.instanceCustomIndex = frame;
+    VkAccelerationStructureInstanceKHR hidden = Instance(0, 1, 1.0f * frame);
+    hidden.mask = 0x80;
+    VkAccelerationStructureInstanceKHR third = Instance(scene.b.address(), 2, -0.5f * frame);
+    third.transform.matrix[1][1] = 1.0f + 0.25f * frame;
+    scene.HostWrite({first, hidden, third});
+    commands.Submit(update);
+  }
+}
+
+CORPUS_CASE(TlasLateBlas, "capture-tlas-references-blas-created-after-recording", "history",
+            "the TLAS command buffer recorded first; a BLAS created and built later is written into the mapped "
+            "instances before the TLAS command buffer is submitted",
+            {}) {
+  Scene scene(device);
+  Commands commands(device);
+  VkCommandBuffer rebuild = commands.Begin();
+  scene.Record(rebuild, 2, kBuild);
+  commands.End(rebuild);
+  Blas late(device, scene.inputs);
+  device.OneShot([&](VkCommandBuffer cb) { late.Build(cb, Shape{}); });
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(late.address(), 1)});
+  commands.Submit(rebuild);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  commands.Submit(rebuild);
 }
 
 }  // namespace

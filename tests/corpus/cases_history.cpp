@@ -307,6 +307,114 @@ CORPUS_CASE(SimultaneousUseContradicts, "history-simultaneous-use-refit-fewer-pr
   vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
 }
 
+// A secondary that builds the BLAS with `geometries`, (re-)recorded, and the primary executing it (re-)recorded too:
+// re-recording a secondary invalidates the primaries it was recorded into.
+void RecordSecondaryBuild(vkkit::Device& device, Commands& commands, Blas& blas, VkCommandBuffer secondary,
+                          VkCommandBuffer primary, uint32_t geometries) {
+  Procs procs(device);
+  VkCommandBufferInheritanceInfo inheritance{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.pInheritanceInfo = &inheritance;
+  vkkit::Check(vkBeginCommandBuffer(secondary, &begin), "vkBeginCommandBuffer");
+  blas.Build(secondary, Geometries(geometries));
+  commands.End(secondary);
+  const VkCommandBufferBeginInfo primary_begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkkit::Check(vkBeginCommandBuffer(primary, &primary_begin), "vkBeginCommandBuffer");
+  procs.CmdExecuteCommands(primary, 1, &secondary);
+  commands.End(primary);
+}
+
+// The streaming pattern: a secondary builds the BLAS with 1 geometry; it is re-recorded with 2 (and its primary
+// with it) and submitted; the refit follows.
+void RerecordedSecondary(vkkit::Device& device, uint32_t refit_geometries) {
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  VkCommandBuffer secondary = BeginWith(device, commands, VK_COMMAND_BUFFER_LEVEL_SECONDARY, 0);
+  commands.End(secondary);
+  VkCommandBuffer primary = commands.Begin();
+  commands.End(primary);
+  RecordSecondaryBuild(device, commands, blas, secondary, primary, 1);
+  commands.Submit(primary);
+  VkCommandBuffer refit = RecordUpdate(commands, blas, Geometries(refit_geometries));
+  RecordSecondaryBuild(device, commands, blas, secondary, primary, 2);
+  commands.Submit(primary);
+  commands.Submit(refit);
+}
+
+CORPUS_CASE(RerecordedSecondaryOldRefit, "history-rerecorded-secondary-refit-of-old-recording", "history",
+            "a secondary building the BLAS with 1 geometry is re-recorded with 2 and its primary submitted again; the "
+            "refit recorded in between still repeats the 1-geometry build",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758"}) {
+  RerecordedSecondary(device, 1);
+}
+
+CORPUS_CASE(RerecordedSecondaryNewRefit, "history-rerecorded-secondary-refit-of-new-recording", "history",
+            "a secondary building the BLAS with 1 geometry is re-recorded with 2 and its primary submitted again; the "
+            "refit, recorded before that re-recording, repeats the 2-geometry build",
+            {}) {
+  RerecordedSecondary(device, 2);
+}
+
+CORPUS_CASE(ResetCommandBufferForgets, "history-reset-command-buffer-rerecorded", "history",
+            "a frame's command buffer that built the BLAS with 1 geometry is reset and re-recorded with a 2-geometry "
+            "build; after it runs, a 2-geometry refit",
+            {}) {
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  VkCommandBuffer frame = RecordBuild(commands, blas, Geometries(1));
+  commands.Submit(frame);
+  vkkit::Check(vkResetCommandBuffer(frame, 0), "vkResetCommandBuffer");
+  const VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkkit::Check(vkBeginCommandBuffer(frame, &begin), "vkBeginCommandBuffer");
+  commands.Barrier(frame);
+  blas.Build(frame, Geometries(2));
+  commands.End(frame);
+  commands.Submit(frame);
+  commands.Submit(RecordUpdate(commands, blas, Geometries(2)));
+}
+
+CORPUS_CASE(RefitIntoOtherStructure, "history-refit-into-another-structure", "history",
+            "a 2-geometry BLAS refitted into a second structure (srcAccelerationStructure != dst), which is then "
+            "refitted in place every frame",
+            {}) {
+  Inputs inputs(device);
+  Blas source(device, inputs), target(device, inputs);
+  Commands commands(device);
+  commands.Submit(RecordBuild(commands, source, Geometries(2)));
+  commands.Submit(RecordUpdate(commands, target, Geometries(2), &source));
+  VkCommandBuffer refit = RecordUpdate(commands, target, Geometries(2));
+  for (int frame = 0; frame < 3; ++frame) commands.Submit(refit);
+}
+
+CORPUS_CASE(RefitIntoOtherStructureSourceRebuilt, "history-refit-into-another-structure-source-rebuilt", "history",
+            "a refit from BLAS a into BLAS b, recorded when a had 2 geometries, submitted after a was rebuilt with 1",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758"}) {
+  Inputs inputs(device);
+  Blas source(device, inputs), target(device, inputs);
+  Commands commands(device);
+  commands.Submit(RecordBuild(commands, source, Geometries(2)));
+  VkCommandBuffer refit = RecordUpdate(commands, target, Geometries(2), &source);
+  commands.Submit(RecordBuild(commands, source, Geometries(1)));
+  commands.Submit(refit);
+}
+
+CORPUS_CASE(RecreatedStructureCloned, "history-recreated-structure-cloned-before-build", "history",
+            "a BLAS built, destroyed and created again in the same buffer (same address), then cloned before the new "
+            "structure is built",
+            {"VUID-VkCopyAccelerationStructureInfoKHR-src-04963"}) {
+  Inputs inputs(device);
+  Blas blas(device, inputs), copy(device, inputs);
+  Commands commands(device);
+  commands.Submit(RecordBuild(commands, blas, Shape{}));
+  blas.Recreate();
+  VkCommandBuffer clone = commands.Begin();
+  asval_test::CmdCopy(device, clone, blas.handle(), copy.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
+  commands.End(clone);
+  commands.Submit(clone);
+}
+
 // ---- what an update must repeat, one rule each -----------------------------------------------------------------
 
 // The BLAS built with `build`, then refitted with `update` in a later frame (device), or on the host.
