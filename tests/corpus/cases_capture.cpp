@@ -162,6 +162,29 @@ CORPUS_CASE(InactiveTriangleStaysInactive, "capture-inactive-triangle-stays-inac
   }
 }
 
+CORPUS_CASE(HiddenTriangleAllNan, "capture-hidden-triangle-all-nan-positions", "history",
+            "a skinning pass hides triangle 1 by writing (NaN, NaN, NaN) to all its vertices before the build and "
+            "every refit (vkCmdCopyBuffer), while triangle 0 moves",
+            {}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  Staging staging(device, 6 * 12);
+  for (int frame = 0; frame <= 3; ++frame) {
+    std::vector<float> positions = Positions(0.25f * frame);
+    for (size_t i = 3 * 3; i < positions.size(); ++i) positions[i] = kNan;
+    staging.Fill(positions);
+    device.OneShot([&](VkCommandBuffer cb) {
+      staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+      asval_test::InputsWritten(cb);
+      if (frame == 0) {
+        blas.Build(cb, TwoTriangles());
+      } else {
+        blas.Update(cb, TwoTriangles());
+      }
+    });
+  }
+}
+
 CORPUS_CASE(DegenerateTriangleStaysActive, "capture-degenerate-triangle-stays-active", "history",
             "a refit whose copied positions collapse triangle 1 to a point (degenerate, still active), and the next "
             "refit restores it",

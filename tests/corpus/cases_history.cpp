@@ -534,11 +534,9 @@ CORPUS_CASE(RefitPrimitiveCountDiffers, "history-refit-more-primitives", "histor
 
 // A structure created GENERIC may be built as either level; its update must still be of the level it was built
 // as (03760), and an instance geometry is then never the triangle geometry it was built with (03761).
-CORPUS_CASE(RefitGenericAsOtherLevel, "history-generic-structure-refit-as-other-level", "history",
-            "a GENERIC structure built as a bottom-level structure of one triangle, then updated as a top-level "
-            "structure of one instance",
-            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03760",
-             "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03761"}) {
+// The GENERIC structure built on the device as a bottom-level structure, then updated as a top-level one on the
+// device or (`host`) by vkBuildAccelerationStructuresKHR.
+void GenericRefitAsOtherLevel(vkkit::Device& device, bool host) {
   Inputs inputs(device);
   Blas referenced(device, inputs);
   asval_test::BuildInfo bottom = asval_test::MakeBuildInfo(Shape{}, inputs);
@@ -564,20 +562,45 @@ CORPUS_CASE(RefitGenericAsOtherLevel, "history-generic-structure-refit-as-other-
     referenced.Build(cb, Shape{});
     procs.CmdBuild(cb, 1, &bottom.info, &bottom.range_pointer);
   });
-  Commands commands(device);
-  VkCommandBuffer update = commands.Begin();
-  procs.CmdBuild(update, 1, &top.info, &top.range_pointer);
-  commands.End(update);
-  commands.Submit(update);
+  if (host) {
+    top.info.scratchData.hostAddress = scratch.mapped;
+    top.geometries[0].geometry.instances.data.hostAddress = instances.mapped;
+    // A host build's instances name structures by handle, not by device address.
+    static_cast<VkAccelerationStructureInstanceKHR*>(instances.mapped)->accelerationStructureReference =
+        reinterpret_cast<uint64_t>(referenced.handle());
+    procs.HostBuild(device.handle(), VK_NULL_HANDLE, 1, &top.info, &top.range_pointer);
+  } else {
+    Commands commands(device);
+    VkCommandBuffer update = commands.Begin();
+    procs.CmdBuild(update, 1, &top.info, &top.range_pointer);
+    commands.End(update);
+    commands.Submit(update);
+  }
   device.Destroy(scratch);
   device.Destroy(generic);
   device.Destroy(instances);
+}
+
+CORPUS_CASE(RefitGenericAsOtherLevel, "history-generic-structure-refit-as-other-level", "history",
+            "a GENERIC structure built as a bottom-level structure of one triangle, then updated as a top-level "
+            "structure of one instance",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03760",
+             "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03761"}) {
+  GenericRefitAsOtherLevel(device, false);
 }
 
 // Host refits: lavapipe has no host commands, so these calls are also made on a device without
 // accelerationStructureHostCommands, which is a fault of its own (03581) that each of them also carries; a layer
 // that stops the call keeps it from the driver.
 constexpr const char* kHostCommands = "VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581";
+CORPUS_CASE(HostRefitGenericAsOtherLevel, "history-host-generic-structure-refit-as-other-level", "history",
+            "a GENERIC structure built on the device as a bottom-level structure of one triangle, then updated on the "
+            "host as a top-level structure of one instance",
+            {kHostCommands, "VUID-vkBuildAccelerationStructuresKHR-pInfos-03760",
+             "VUID-vkBuildAccelerationStructuresKHR-pInfos-03761"}) {
+  GenericRefitAsOtherLevel(device, true);
+}
+
 CORPUS_CASE(HostRefitWithoutAllowUpdate, "history-host-refit-of-build-without-allow-update", "history",
             "a BLAS built on the device without ALLOW_UPDATE, refitted by vkBuildAccelerationStructuresKHR",
             {kHostCommands, "VUID-vkBuildAccelerationStructuresKHR-pInfos-03667"}) {
