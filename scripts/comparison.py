@@ -38,7 +38,7 @@ CAPTURE_CONFIGS = {
 FAMILY_CONFIGS = {"asval-no-" + f: ENV_PREFIX + "ENABLED_CHECKS=" + ",".join(x for x in FAMILIES if x != f)
                   for f in FAMILIES}
 # The rows measured for every configuration of the view (the others run only for none, asval and khronos).
-VIEW_ROWS = ["build 1x1", "submit 1000 builds+updates", "scene dynamic"]
+VIEW_ROWS = ["build 1x1", "submit 1000 build+update", "frame dynamic"]
 
 
 def ensure_matplotlib():
@@ -107,12 +107,13 @@ def run_corpus(build, out):
 
 def run_overhead(build, out, rounds):
     script = os.path.join(ROOT, "bench", "overhead", "run_overhead.py")
-    main = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--out", out]
+    main = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--json", out]
     print("+ " + " ".join(main), flush=True)
     subprocess.run(main, check=True)
-    view = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--out", out + ".view",
-            "--only-configs", "--rows", ",".join(VIEW_ROWS)]
-    for name, env in dict(CAPTURE_CONFIGS, **FAMILY_CONFIGS).items():
+    # Each family switched off: the rows the view plots, against none measured again in the same run.
+    view = [sys.executable, script, "--build", build, "--callgrind", "--rounds", str(rounds), "--json", out + ".view",
+            "--rows", ",".join(VIEW_ROWS), "--configs", ",".join(["none"] + list(FAMILY_CONFIGS))]
+    for name, env in FAMILY_CONFIGS.items():
         view += ["--config", "%s:%s" % (name, env)]
     print("+ " + " ".join(view), flush=True)
     subprocess.run(view, check=True)
@@ -120,8 +121,22 @@ def run_overhead(build, out, rounds):
         merged = json.load(f)
     with open(out + ".view") as f:
         extra = json.load(f)
-    seen = {(r["row"], r["config"]) for r in merged["rows"]}
-    merged["rows"] += [r for r in extra["rows"] if (r["row"], r["config"]) not in seen]
+    # The family rows are taken relative to their own run's none: stored as that ratio applied to the main run's.
+    look = {(r["row"], r["config"]): r for r in extra["rows"]}
+    main_none = {r["row"]: r for r in merged["rows"] if r["config"] == "none"}
+    for r in extra["rows"]:
+        if r["config"] == "none":
+            continue
+        base, ref = look.get((r["row"], "none")), main_none.get(r["row"])
+        if base and ref and base["wall_ns_median"] and ref["wall_ns_median"]:
+            scale = ref["wall_ns_median"] / base["wall_ns_median"]
+            for key in ("wall_ns_min", "wall_ns_median"):
+                r[key] = r[key] * scale
+        if base and ref and r.get("ir_per_call") is not None and base.get("ir_per_call") is not None \
+                and ref.get("ir_per_call") is not None:
+            r["ir_per_call"] = r["ir_per_call"] - base["ir_per_call"] + ref["ir_per_call"]
+        r["rescaled_to_main_none"] = True
+        merged["rows"].append(r)
     merged["command_view"] = extra.get("command")
     with open(out, "w") as f:
         json.dump(merged, f, indent=1)
@@ -239,9 +254,9 @@ def view_points(cases, overhead):
         missed = sorted({c["name"] for c in cases if c["expected"] and config in c["results"]
                          and c["results"][config]["missed"]})
         points.append({"config": config, "detected": detected, "expected": expected, "missed": missed,
-                       "scene": added_percent(look, "scene dynamic", config),
+                       "scene": added_percent(look, "frame dynamic", config),
                        "build_ir": added_ir(look, "build 1x1", config),
-                       "submit_ir": added_ir(look, "submit 1000 builds+updates", config)})
+                       "submit_ir": added_ir(look, "submit 1000 build+update", config)})
     return points
 
 

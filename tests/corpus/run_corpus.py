@@ -87,9 +87,14 @@ def configurations(layer_path, extra, driver_files):
     for spec in extra:
         name, _, settings = spec.partition(":")
         env = dict(configs["asval"])
-        for pair in filter(None, settings.split(",")):
-            key, _, value = pair.partition("=")
-            env[key] = value
+        key = None
+        for part in settings.split(","):
+            # A part that is not ENV=... continues the value before it (ENABLED_CHECKS=features,handles).
+            if re.match(r"^[A-Za-z_][A-Za-z0-9_]*=", part) or key is None:
+                key, _, value = part.partition("=")
+                env[key] = value
+            else:
+                env[key] += "," + part
         configs[name] = env
     return configs
 
