@@ -222,6 +222,92 @@ CORPUS_CASE(ResubmittedRefitHostNan, "capture-resubmitted-refit-host-writes-nan"
   }
 }
 
+// Programs learn of completion in several ways; each is where the bytes a refit read become known.
+void CopyNanAndRefitThenWait(vkkit::Device& device, asval_test::Wait wait, bool nan) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  Staging staging(device, 6 * 12);
+  std::vector<float> positions = Positions(0.75f);
+  if (nan) positions[3 * 0] = kNan;
+  staging.Fill(positions);
+  VkCommandBuffer refit = asval_test::RecordWith(commands, [&](VkCommandBuffer cb) {
+    staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, TwoTriangles());
+  });
+  asval_test::SubmitAndWait(device, refit, wait);
+}
+
+CORPUS_CASE(RefitNanFenceWait, "capture-refit-copy-nan-waited-by-fence", "history",
+            "a refit after a vkCmdCopyBuffer of positions with a NaN X in triangle 0, the submission waited for with "
+            "vkWaitForFences",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  CopyNanAndRefitThenWait(device, asval_test::Wait::kFence, true);
+}
+
+CORPUS_CASE(RefitNanDeviceIdle, "capture-refit-copy-nan-waited-by-device-idle", "history",
+            "a refit after a vkCmdCopyBuffer of positions with a NaN X in triangle 0, the submission waited for with "
+            "vkDeviceWaitIdle",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  CopyNanAndRefitThenWait(device, asval_test::Wait::kDeviceIdle, true);
+}
+
+CORPUS_CASE(RefitFencePolled, "capture-refit-copy-waited-by-fence-polling", "history",
+            "a refit after a vkCmdCopyBuffer of moved positions, the submission's fence polled with vkGetFenceStatus",
+            {}) {
+  CopyNanAndRefitThenWait(device, asval_test::Wait::kFenceStatus, false);
+}
+
+CORPUS_CASE(RefitRecordedFirstInFlight, "capture-refit-recorded-first-both-in-flight", "history",
+            "a refit command buffer (copy of positions with a NaN X in triangle 1, then the refit) recorded before the "
+            "build's; both submitted without a wait in between, build first, then one vkQueueWaitIdle",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Staging staging(device, 6 * 12);
+  std::vector<float> positions = Positions(0.5f);
+  positions[3 * 3] = kNan;
+  staging.Fill(positions);
+  VkCommandBuffer refit = asval_test::RecordWith(commands, [&](VkCommandBuffer cb) {
+    // The build of the earlier submission wrote the structure and read the vertices this copy overwrites.
+    commands.Barrier(cb);
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         0, nullptr, 0, nullptr, 0, nullptr);
+    staging.CopyTo(cb, inputs.buffer().buffer, Inputs::kVerticesOffset, 6 * 12);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, TwoTriangles());
+  });
+  VkCommandBuffer build = asval_test::RecordWith(commands, [&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles()); });
+  for (VkCommandBuffer cb : {build, refit}) {
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    vkkit::Check(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
+  }
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+}
+
+CORPUS_CASE(RefitUint16IndicesChanged, "capture-refit-update-buffer-changes-uint16-indices", "history",
+            "a BLAS with UINT16 indices written on the host; a vkCmdUpdateBuffer in front of the refit makes triangle "
+            "1 (3, 4, 5) into (3, 4, 0)",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03768"}) {
+  Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  Blas blas(device, inputs);
+  const std::vector<uint16_t> indices = {0, 1, 2, 3, 4, 5};
+  std::memcpy(static_cast<unsigned char*>(inputs.buffer().mapped) + Inputs::kIndicesOffset, indices.data(),
+              indices.size() * sizeof(uint16_t));
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, TwoTriangles(VK_INDEX_TYPE_UINT16)); });
+  device.OneShot([&](VkCommandBuffer cb) {
+    const uint16_t last_pair[2] = {4, 0};  // indices 4 and 5 (a 4-byte aligned update)
+    vkCmdUpdateBuffer(cb, inputs.buffer().buffer, Inputs::kIndicesOffset + 4 * 2, sizeof last_pair, last_pair);
+    asval_test::InputsWritten(cb);
+    blas.Update(cb, TwoTriangles(VK_INDEX_TYPE_UINT16));
+  });
+}
+
 CORPUS_CASE(RefitCopyChangesIndices, "capture-refit-copy-changes-indices", "history",
             "an indexed BLAS (UINT32) refitted after a vkCmdCopyBuffer that rewrites its index buffer with other "
             "values (triangle 0 becomes 0, 1, 3)",
@@ -564,6 +650,22 @@ CORPUS_CASE(TlasSecondaryDestroyedBlas, "capture-tlas-build-in-secondary-referen
   commands.End(primary);
   scene.b.DestroyHandle();
   commands.Submit(primary);
+}
+
+CORPUS_CASE(TlasUpdateDestroyedBlas, "capture-tlas-update-references-destroyed-blas", "history",
+            "a TLAS over BLASes a and b updated every frame by one command buffer; b is destroyed (its pool buffer "
+            "stays) and the next update still reads its instance",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-06707"}) {
+  Scene scene(device);
+  Commands commands(device);
+  scene.HostWrite({Instance(scene.a.address(), 0), Instance(scene.b.address(), 1)});
+  device.OneShot([&](VkCommandBuffer cb) { scene.Record(cb, 2, kBuild); });
+  VkCommandBuffer update = commands.Begin();
+  scene.Record(update, 2, kUpdate);
+  commands.End(update);
+  commands.Submit(update);
+  scene.b.DestroyHandle();
+  commands.Submit(update);
 }
 
 CORPUS_CASE(TlasUpdateMovesInstances, "capture-tlas-update-changes-transforms-masks", "history",

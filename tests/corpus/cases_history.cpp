@@ -105,6 +105,17 @@ CORPUS_CASE(UpdateRecordedFirstTwoBatches, "history-update-recorded-first-two-ba
   vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
 }
 
+CORPUS_CASE(UpdateFirstInOneBatch, "history-update-before-build-in-one-batch", "history",
+            "the refit and the BLAS build command buffers submitted in one batch, the refit listed first",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03667"}) {
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  VkCommandBuffer build = RecordBuild(commands, blas, Shape{});
+  VkCommandBuffer refit = RecordUpdate(commands, blas, Shape{});
+  commands.Submit({refit, build});
+}
+
 CORPUS_CASE(UpdateAgainstBuildExecutedLast, "history-update-matches-build-recorded-last-not-executed-last", "history",
             "two builds of one BLAS (1 and 2 geometries) recorded in that order, submitted in the other; a 2-geometry "
             "refit then contradicts the 1-geometry build that executed last",
