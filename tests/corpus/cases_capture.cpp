@@ -100,7 +100,7 @@ void CopyAndRefit(vkkit::Device& device, Blas& blas, const Inputs& inputs, const
 // ---- bottom-level refits -------------------------------------------------------------------------------------
 
 CORPUS_CASE(RefitCopyMakesTriangleInactive, "capture-refit-copy-makes-triangle-inactive", "history",
-            "a deforming BLAS refitted every frame from positions copied by vkCmdCopyBuffer; in frame 3 the positions "
+            "a deforming BLAS refitted every frame from positions copied by vkCmdCopyBuffer; in frame 3 the simulation "
             "culls a triangle with a NaN X, which the BLAS build had active",
             {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
   Inputs inputs(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
