@@ -51,11 +51,28 @@ def load_aliases():
         return json.load(f).get("aliases", {})
 
 
+def registry_families():
+    """VUID -> its rule family in asval's check registry (scripts/checks/<family>.json)."""
+    families = {}
+    checks = os.path.join(ROOT, "scripts", "checks")
+    for name in sorted(os.listdir(checks)):
+        if name.endswith(".json"):
+            with open(os.path.join(checks, name)) as f:
+                for entry in json.load(f):
+                    families[entry["vuid"]] = entry["family"]
+    return families
+
+
 def list_cases(corpus, scene):
+    """Every case with its label. A fault case of the corpus program counts in the family that asval's registry
+    gives its first VUID (what switching that family off loses); a valid case in the family it names."""
+    families = registry_families()
     cases = []
     out = subprocess.run([corpus, "--list"], stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
     for c in json.loads(out):
         c["command"] = [corpus, c["name"]]
+        if c["expected"]:
+            c["family"] = families.get(c["expected"][0], c["family"])
         cases.append(c)
     if scene:
         out = subprocess.run([scene, "--list-faults"], stdout=subprocess.PIPE, universal_newlines=True,
