@@ -26,13 +26,15 @@ bool Fail(std::string* error, std::string message) {
 }  // namespace
 
 const char* Usage() {
-  return "usage: asval_scene [--frames N] [--instances N] [--size WxH] [--out FILE.png] [--inject FAULT]\n"
+  return "usage: asval_scene [--frames N] [--instances N] [--size WxH] [--static] [--out FILE.png] [--inject FAULT]\n"
          "       asval_scene --list-faults\n"
          "Renders an animated ray-traced scene without a window (any device with VK_KHR_acceleration_structure\n"
          "and VK_KHR_ray_tracing_pipeline). Layers come from the environment (VK_INSTANCE_LAYERS).\n"
          "  --frames N      frames to render (default 4)\n"
          "  --instances N   instances in the top-level structure, the ground included (default 2000)\n"
          "  --size WxH      image size (default 256x256)\n"
+         "  --static        build the structures in frame 0 only; later frames only trace rays (no animation,\n"
+         "                  refit or top-level update)\n"
          "  --out FILE      write the last frame as PNG\n"
          "  --inject FAULT  after the frames, commit one rule violation (see --list-faults)\n"
          "  --list-faults   print each fault with the VUID it must trigger\n";
@@ -44,6 +46,8 @@ bool ParseOptions(int argc, char** argv, SceneOptions* o, std::string* error) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(a, "--help") == 0 || std::strcmp(a, "-h") == 0) {
       o->help = true;
+    } else if (std::strcmp(a, "--static") == 0) {
+      o->static_scene = true;
     } else if (std::strcmp(a, "--list-faults") == 0) {
       o->list_faults = true;
     } else if (std::strcmp(a, "--frames") == 0 && has_value) {

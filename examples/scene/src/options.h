@@ -14,6 +14,7 @@ struct SceneOptions {
   uint32_t height = 256;
   std::string out;                   // PNG path; empty: no image written
   const FaultInfo* fault = nullptr;  // --inject
+  bool static_scene = false;  // --static: structures built once, frames only trace rays
   bool list_faults = false;
   bool help = false;
 };

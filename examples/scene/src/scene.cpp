@@ -83,6 +83,10 @@ void Scene::RecordCommandBuffers() {
 }
 
 void Scene::Frame(uint32_t frame) {
+  if (options.static_scene && frame > 0) {  // the structures of frame 0 stay as they are
+    Check(gpu.SubmitAndWait({trace_}), "frame: vkQueueSubmit");
+    return;
+  }
   const uint32_t p = frame % 2;
   const float t = TimeOf(frame);
   deforming.params().time = t;
@@ -109,7 +113,8 @@ void Scene::RunFrames() {
   const double rest_s = std::chrono::duration<double>(Clock::now() - after_first).count();
   std::printf("frames: %u; frame 0 (builds) %.1f ms", options.frames, first_ms);
   if (options.frames > 1) {
-    std::printf("; frames 1..%u (refits) %.2f fps", options.frames - 1, (options.frames - 1) / rest_s);
+    std::printf("; frames 1..%u (%s) %.2f fps", options.frames - 1, options.static_scene ? "trace only" : "refits",
+                (options.frames - 1) / rest_s);
   }
   std::printf("\n");
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The scene: its parts, the command buffers it reuses every frame, and the frame loop. A frame is one
 // submission of three command buffers: animate + refit the deforming structures (or, in frame 0, build them),
-// update (every 4th frame: rebuild) the top-level structure, trace.
+// update (every 4th frame: rebuild) the top-level structure, trace. With --static, frames after frame 0 only
+// trace.
 //
 // The reusable command buffers are recorded before the one that first builds the deforming structures,
 // which they update: recording order is not execution order, and a validator must follow the latter.

@@ -1,36 +1,36 @@
-// record_builds: the cost of the layer on the hot path. Records N vkCmdBuildAccelerationStructuresKHR calls
-// (valid, never submitted) into one command buffer, with whatever layers the environment enables, and
-// prints the wall time per call. Under callgrind only the recording loop is instrumented, so
-//   valgrind --tool=callgrind --instr-atstart=no ./record_builds 20000
-// with and without VK_INSTANCE_LAYERS=VK_LAYER_ASVAL_as_validation gives the instructions per call that the
-// layer adds (the difference of the two totals divided by N). Arguments: calls, infos per call, geometries per
-// info, and optionally "own" (every info gets a scratch buffer of its own instead of a slice of one shared buffer)
-// or "own-inputs" (also its own vertex buffer and its own geometry and range arrays, as an app building many
-// meshes does; without it the infos share one vertex buffer and one geometry array). See docs/performance.md.
-#include <valgrind/callgrind.h>
-
+// record_builds: what the layers cost per vkCmdBuildAccelerationStructuresKHR call while recording. Records
+// CALLS valid calls into one command buffer (never submitted), with whatever layers VK_INSTANCE_LAYERS names,
+// and prints the wall time per call; only the recording loop is between the callgrind client requests, so
+//   valgrind --tool=callgrind --instr-atstart=no record_builds 5000 1 1 own-inputs
+// with and without the layer gives the instructions per call the layer adds (run_overhead.py does this).
+// Arguments: calls, infos per call, geometries per info (one triangle each), and optionally "own" (every info
+// gets a scratch buffer of its own instead of a slice of one shared buffer) or "own-inputs" (also its own
+// vertex buffer and its own geometry and range arrays, as an app building many meshes does; without it the
+// infos share one vertex buffer and one geometry array). See docs/performance.md.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
 
+#include "bench_device.h"
+#include "instrument.h"
 #include "vkkit.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Run(int argc, char** argv) {
   const int calls = argc > 1 ? std::atoi(argv[1]) : 20000;
   const uint32_t infos_per_call = argc > 2 ? static_cast<uint32_t>(std::atoi(argv[2])) : 1;
   const uint32_t geometries_per_info = argc > 3 ? static_cast<uint32_t>(std::atoi(argv[3])) : 1;
   const bool own_inputs = argc > 4 && std::strcmp(argv[4], "own-inputs") == 0;
   const bool own_buffers = own_inputs || (argc > 4 && std::strcmp(argv[4], "own") == 0);
-  vkkit::InstanceOptions options;  // layers from VK_INSTANCE_LAYERS
-  vkkit::Instance instance(options);
-  VkPhysicalDevice gpu = instance.FindRayTracingGpu();
-  if (!gpu) {
-    std::fprintf(stderr, "no device with VK_KHR_acceleration_structure\n");
-    return 1;
+  if (calls < 1 || infos_per_call < 1 || geometries_per_info < 1) {
+    std::fprintf(stderr, "usage: record_builds CALLS INFOS GEOMETRIES [own|own-inputs]\n");
+    return 2;
   }
-  vkkit::Device device(instance, gpu);
+  overhead::BenchDevice bench;
+  vkkit::Device& device = bench.device();
   vkkit::TriangleBuild build(device);
   // Every info gets geometries_per_info copies of the triangle, its own destination and its own 128-byte
   // aligned scratch slice, all sized by the driver: the calls are valid, so the layer reports nothing.
@@ -82,19 +82,23 @@ int main(int argc, char** argv) {
   device.OneShot(
       [&](VkCommandBuffer cb) {
         const auto start = std::chrono::steady_clock::now();
-        CALLGRIND_START_INSTRUMENTATION;
+        OVERHEAD_START_INSTRUMENTATION;
         for (int i = 0; i < calls; ++i) {
           device.CmdBuildAccelerationStructuresKHR(cb, infos_per_call, infos.data(), ranges.data());
         }
-        CALLGRIND_STOP_INSTRUMENTATION;
+        OVERHEAD_STOP_INSTRUMENTATION;
         seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       },
       /*submit=*/false);
-  std::printf("%d calls x %u infos x %u geometries%s: %.1f ns per call\n", calls, infos_per_call,
-              geometries_per_info, own_inputs ? " (own buffers and arrays)" : own_buffers ? " (own scratch buffers)" : "", seconds * 1e9 / calls);
+  std::printf("%d calls x %u infos x %u geometries%s\n", calls, infos_per_call, geometries_per_info,
+              own_inputs ? " (own buffers and arrays)" : own_buffers ? " (own scratch buffers)" : "");
   for (vkkit::AccelerationStructure& as : destinations) device.Destroy(as);
   for (vkkit::Buffer& b : own) device.Destroy(b);
   device.Destroy(scratch);
   build.Release(device);
-  return 0;
+  return bench.Finish(calls, seconds);
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return overhead::Main("record_builds", Run, argc, argv); }

@@ -9,10 +9,10 @@ export VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.json VK_LOADER_LAYERS_DIS
 out=$(mktemp -d)
 total() { sed -n 's/^totals: *//p' "$1"; }
 valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$out/without" \
-  "$build/bench/layer_overhead/record_builds" "$@" >/dev/null 2>&1
+  "$build/bench/overhead/record_builds" "$@" >/dev/null 2>&1
 VK_ADD_LAYER_PATH="$build/layer" VK_INSTANCE_LAYERS=VK_LAYER_ASVAL_as_validation \
   valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$out/with" \
-  "$build/bench/layer_overhead/record_builds" "$@" >/dev/null 2>&1
+  "$build/bench/overhead/record_builds" "$@" >/dev/null 2>&1
 without=$(total "$out/without")
 with=$(total "$out/with")
 echo "$* : without $without, with $with, driver/call $((without / calls)), layer/call $(((with - without) / calls))"

@@ -1,0 +1,86 @@
+#include "bench_device.h"
+
+#include <cstdio>
+#include <exception>
+#include <stdexcept>
+#include <vector>
+
+namespace overhead {
+
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL Count(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                     VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                     void* user) {
+  BenchDevice& bench = *static_cast<BenchDevice*>(user);
+  const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  error ? ++bench.errors : ++bench.warnings;
+  // The first few are shown: they say why a run was refused.
+  if (bench.errors + bench.warnings <= 3) {
+    std::fprintf(stderr, "%s: %s\n", error ? "error" : "warning", data->pMessage ? data->pMessage : "");
+  }
+  return VK_FALSE;
+}
+
+VkDebugUtilsMessengerCreateInfoEXT MessengerInfo(BenchDevice* bench) {
+  VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+  // Validation messages only: the loader's general ones (e.g. that VK_LOADER_LAYERS_DISABLE switched a layer
+  // off) say nothing about the calls measured.
+  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+  info.pfnUserCallback = Count;
+  info.pUserData = bench;
+  return info;
+}
+
+void PrintDevice(VkPhysicalDevice gpu) {
+  VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+  vkGetPhysicalDeviceProperties2(gpu, &props);
+  std::printf("device: %s; driver: %s %s\n", props.properties.deviceName, driver.driverName, driver.driverInfo);
+}
+
+}  // namespace
+
+BenchDevice::BenchDevice() {
+  // Chained into the create info as well, so that vkCreateInstance's and vkDestroyInstance's messages count.
+  const VkDebugUtilsMessengerCreateInfoEXT messenger = MessengerInfo(this);
+  vkkit::InstanceOptions options;  // no layers named: VK_INSTANCE_LAYERS decides
+  options.pNext = &messenger;
+  instance_ = std::make_unique<vkkit::Instance>(options);
+  auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance_->handle(), "vkCreateDebugUtilsMessengerEXT"));
+  vkkit::Check(create(instance_->handle(), &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  gpu_ = instance_->FindRayTracingGpu();
+  if (!gpu_) throw std::runtime_error("no device with VK_KHR_acceleration_structure");
+  PrintDevice(gpu_);
+  device_ = std::make_unique<vkkit::Device>(*instance_, gpu_);
+}
+
+BenchDevice::~BenchDevice() {
+  device_.reset();
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_->handle(), "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(instance_->handle(), messenger_, nullptr);
+  }
+}
+
+int BenchDevice::Finish(long calls, double seconds) {
+  device_.reset();
+  std::printf("ns_per_call: %.1f calls: %ld\n", seconds * 1e9 / static_cast<double>(calls), calls);
+  std::printf("validation messages: %u error(s), %u warning(s)\n", errors, warnings);
+  return errors + warnings ? 3 : 0;
+}
+
+int Main(const char* program, int (*body)(int argc, char** argv), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "%s: %s\n", program, e.what());
+    return 1;
+  }
+}
+
+}  // namespace overhead
