@@ -6,7 +6,7 @@ set -euo pipefail
 
 # Packages of the system's own suite.
 BASE_PKGS=(g++ cmake ninja-build pkg-config python3 libvulkan-dev vulkan-tools glslang-tools
-           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev nlohmann-json3-dev)
+           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev nlohmann-json3-dev valgrind)
 # Packages that need a newer version than Debian 12 has: lavapipe with ray tracing (bookworm's Mesa 22.3 has none)
 # and Catch2 3 (bookworm has only Catch2 2). Debian 13 has both in main; Debian 12 takes them from
 # bookworm-backports.
