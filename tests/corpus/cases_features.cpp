@@ -1,0 +1,318 @@
+// Family "features": the feature each build command needs, build modes, updates without a source, protected
+// command buffers. Lavapipe has neither accelerationStructureIndirectBuild nor accelerationStructureHostCommands,
+// so every indirect or host build on it also breaks 03650 / 03581: those cases carry that label too.
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "corpus.h"
+#include "memory_placement_helpers.h"
+#include "record_checks_helpers.h"
+
+namespace {
+
+using asval_test::Command;
+using asval_test::IssueWithRealRanges;
+using asval_test::Ranges;
+using asval_test::Scene;
+
+constexpr auto kUpdate = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+
+// A bottom-level build of the scene's one triangle, with a destination and scratch sized by the driver.
+struct TriangleBuild {
+  explicit TriangleBuild(Scene& scene) : geometry(scene.Triangles()) {
+    info = Scene::Info(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, {geometry});
+    info.pGeometries = &geometry;
+    scene.Prepare(info, {1});
+  }
+  // The build through `command`; host builds get host addresses of the same inputs.
+  void Issue(vkkit::Device& device, Scene& scene, Command command) {
+    VkAccelerationStructureGeometryKHR host = scene.OnHost(geometry);
+    VkAccelerationStructureBuildGeometryInfoKHR issued = info;
+    if (command == Command::kHost) issued.pGeometries = &host;
+    const auto ranges = Ranges(1);
+    IssueWithRealRanges(device, command, {issued}, {ranges.data()});
+  }
+  VkAccelerationStructureGeometryKHR geometry;
+  VkAccelerationStructureBuildGeometryInfoKHR info;
+};
+
+// An update whose srcAccelerationStructure was left null, as when an app forgets to set it for a refit.
+void UpdateWithoutSource(vkkit::Device& device, Command command) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  build.info.mode = kUpdate;
+  build.info.srcAccelerationStructure = VK_NULL_HANDLE;
+  build.Issue(device, scene, command);
+}
+
+// A mode that is neither BUILD nor UPDATE (e.g. an uninitialised or mis-cast enum).
+void InvalidMode(vkkit::Device& device, Command command) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  build.info.mode = static_cast<VkBuildAccelerationStructureModeKHR>(2);
+  build.Issue(device, scene, command);
+}
+
+}  // namespace
+
+CORPUS_CASE(FeaturesUpdateWithoutSource, "features-update-without-source", "features",
+            "a refit recorded with mode UPDATE but srcAccelerationStructure left VK_NULL_HANDLE",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-04630"}) {
+  UpdateWithoutSource(device, Command::kDirect);
+}
+
+CORPUS_CASE(FeaturesUpdateWithoutSourceIndirect, "features-update-without-source-indirect", "features",
+            "an indirect refit with srcAccelerationStructure left VK_NULL_HANDLE (lavapipe lacks indirect builds)",
+            {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-04630",
+             "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650"}) {
+  UpdateWithoutSource(device, Command::kIndirect);
+}
+
+CORPUS_CASE(FeaturesUpdateWithoutSourceHost, "features-update-without-source-host", "features",
+            "a host refit with srcAccelerationStructure left VK_NULL_HANDLE (lavapipe lacks host builds)",
+            {"VUID-vkBuildAccelerationStructuresKHR-pInfos-04630",
+             "VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581"}) {
+  UpdateWithoutSource(device, Command::kHost);
+}
+
+CORPUS_CASE(FeaturesInvalidMode, "features-invalid-mode", "features",
+            "a build whose mode is 2, neither BUILD nor UPDATE",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-mode-04628"}) {
+  InvalidMode(device, Command::kDirect);
+}
+
+CORPUS_CASE(FeaturesInvalidModeIndirect, "features-invalid-mode-indirect", "features",
+            "an indirect build whose mode is 2 (lavapipe lacks indirect builds)",
+            {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-mode-04628",
+             "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650"}) {
+  InvalidMode(device, Command::kIndirect);
+}
+
+CORPUS_CASE(FeaturesInvalidModeHost, "features-invalid-mode-host", "features",
+            "a host build whose mode is 2 (lavapipe lacks host builds)",
+            {"VUID-vkBuildAccelerationStructuresKHR-mode-04628",
+             "VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581"}) {
+  InvalidMode(device, Command::kHost);
+}
+
+CORPUS_CASE(FeaturesIndirectWithoutFeature, "features-indirect-build-without-feature", "features",
+            "an otherwise valid indirect BLAS build, ranges in a real indirect buffer, on a device without "
+            "accelerationStructureIndirectBuild",
+            {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650"}) {
+  Scene scene(device);
+  TriangleBuild(scene).Issue(device, scene, Command::kIndirect);
+}
+
+CORPUS_CASE(FeaturesHostWithoutFeature, "features-host-build-without-feature", "features",
+            "an otherwise valid host BLAS build from mapped inputs, on a device without "
+            "accelerationStructureHostCommands",
+            {"VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581"}) {
+  Scene scene(device);
+  TriangleBuild(scene).Issue(device, scene, Command::kHost);
+}
+
+namespace {
+
+// A command buffer of a pool created PROTECTED. Lavapipe has no protectedMemory, so creating the pool is itself
+// invalid (VkCommandPoolCreateInfo-flags-02860, a rule outside asval's families); lavapipe creates it all the same
+// and the command buffer is only recorded, never submitted. A layer that stops the pool's creation leaves `cb` null:
+// the program records nothing then, as an app stopping on that error would.
+struct ProtectedCommandBuffer {
+  explicit ProtectedCommandBuffer(vkkit::Device& d) : device(d.handle()) {
+    VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    info.flags = VK_COMMAND_POOL_CREATE_PROTECTED_BIT;
+    info.queueFamilyIndex = 0;  // lavapipe's only queue family, the one vkkit::Device uses
+    if (vkCreateCommandPool(device, &info, nullptr, &pool) != VK_SUCCESS) return;
+    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    alloc.commandPool = pool;
+    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    alloc.commandBufferCount = 1;
+    vkkit::Check(vkAllocateCommandBuffers(device, &alloc, &cb), "vkAllocateCommandBuffers");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
+  }
+  ~ProtectedCommandBuffer() {
+    if (!pool) return;
+    vkEndCommandBuffer(cb);
+    vkDestroyCommandPool(device, pool, nullptr);
+  }
+  VkDevice device;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+};
+
+}  // namespace
+
+CORPUS_CASE(FeaturesProtectedCommandBuffer, "features-build-in-protected-command-buffer", "features",
+            "a BLAS build recorded into a command buffer of a protected pool",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-commandBuffer-09547"}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  const auto ranges = Ranges(1);
+  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = ranges.data();
+  ProtectedCommandBuffer protected_cb(device);
+  if (protected_cb.cb) device.CmdBuildAccelerationStructuresKHR(protected_cb.cb, 1, &build.info, &range_pointer);
+}
+
+CORPUS_CASE(FeaturesProtectedCommandBufferIndirect, "features-indirect-build-in-protected-command-buffer", "features",
+            "an indirect BLAS build recorded into a command buffer of a protected pool (lavapipe lacks indirect "
+            "builds)",
+            {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-commandBuffer-09547",
+             "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650"}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  vkkit::Buffer ranges = device.CreateBuffer(16, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+  std::memcpy(ranges.mapped, &range, sizeof range);
+  auto indirect = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
+      vkGetDeviceProcAddr(device.handle(), "vkCmdBuildAccelerationStructuresIndirectKHR"));
+  const uint32_t stride = 16;
+  const uint32_t max_count = 1;
+  const uint32_t* max_counts = &max_count;
+  {
+    ProtectedCommandBuffer protected_cb(device);
+    if (protected_cb.cb) indirect(protected_cb.cb, 1, &build.info, &ranges.address, &stride, &max_counts);
+  }
+  device.Destroy(ranges);
+}
+
+// Valid twins: what the mode and source rules could confuse.
+
+CORPUS_CASE(FeaturesRefitInPlace, "features-refit-in-place", "features",
+            "a BLAS built, then refitted in place (src == dst) in a second submission", {}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  const auto ranges = Ranges(1);
+  scene.BuildNow({build.info}, {ranges.data()});
+  build.info.mode = kUpdate;
+  build.info.srcAccelerationStructure = build.info.dstAccelerationStructure;
+  scene.BuildNow({build.info}, {ranges.data()});
+}
+
+CORPUS_CASE(FeaturesRefitIntoOther, "features-refit-into-other-structure", "features",
+            "a BLAS built, then updated from it into a second structure of the same size", {}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  const auto ranges = Ranges(1);
+  scene.BuildNow({build.info}, {ranges.data()});
+  VkAccelerationStructureBuildGeometryInfoKHR update = build.info;
+  update.mode = kUpdate;
+  update.srcAccelerationStructure = build.info.dstAccelerationStructure;
+  scene.Prepare(update, {1});  // a new destination and scratch slice; the source stays
+  scene.BuildNow({update}, {ranges.data()});
+}
+
+CORPUS_CASE(FeaturesBuildAndRefitOneCall, "features-build-one-refit-another-in-one-call", "features",
+            "one vkCmdBuildAccelerationStructuresKHR building one BLAS and refitting another built earlier", {}) {
+  Scene scene(device);
+  TriangleBuild first(scene), second(scene);
+  const auto ranges = Ranges(1);
+  scene.BuildNow({first.info}, {ranges.data()});
+  VkAccelerationStructureBuildGeometryInfoKHR refit = first.info;
+  refit.mode = kUpdate;
+  refit.srcAccelerationStructure = first.info.dstAccelerationStructure;
+  scene.BuildNow({second.info, refit}, {ranges.data(), ranges.data()});
+}
+
+namespace {
+
+// The layers report to the messengers of the device's own instance, and the corpus program hands cases its device
+// only: the case without the feature makes an instance of its own and prints what that instance's messenger
+// receives in the corpus program's line format (the text left out: the runner reads severities and ids).
+VKAPI_ATTR VkBool32 VKAPI_CALL PrintToCorpus(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                             VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  const bool error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  std::string id;
+  for (const char* c = data->pMessageIdName ? data->pMessageIdName : ""; *c; ++c) {
+    if (std::isalnum(static_cast<unsigned char>(*c)) || *c == '-' || *c == '_') id += *c;  // nothing to escape
+  }
+  std::printf("{\"severity\": \"%s\", \"id\": \"%s\", \"text\": \"\"}\n", error ? "error" : "warning", id.c_str());
+  std::fflush(stdout);
+  return error ? VK_TRUE : VK_FALSE;
+}
+
+uint32_t ComputeQueueFamily(VkPhysicalDevice gpu) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
+  for (uint32_t i = 0; i < count; ++i) {
+    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+  }
+  return 0;
+}
+
+}  // namespace
+
+// A device created with VK_KHR_acceleration_structure but without enabling its accelerationStructure feature (an
+// app that forgot the feature structure in pNext), then an empty build recorded on it.
+CORPUS_CASE(FeaturesNoAccelerationStructureFeature, "features-build-without-as-feature",
+            "features",
+            "a device with the acceleration-structure extension but the accelerationStructure feature not enabled "
+            "records a build",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-accelerationStructure-08923",
+             // No structure can be created without the feature (vkCreateAccelerationStructureKHR-03611), so the
+             // build has no destination either.
+             "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03800"}) {
+  VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  messenger_info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+  messenger_info.pfnUserCallback = &PrintToCorpus;
+  vkkit::InstanceOptions options;
+  options.layers = vkkit::LayersFromEnvironment();
+  options.pNext = &messenger_info;
+  vkkit::Instance instance(options);
+  auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance.handle(), "vkCreateDebugUtilsMessengerEXT"));
+  auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance.handle(), "vkDestroyDebugUtilsMessengerEXT"));
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  vkkit::Check(create_messenger(instance.handle(), &messenger_info, nullptr, &messenger),
+               "vkCreateDebugUtilsMessengerEXT");
+  VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue.queueFamilyIndex = ComputeQueueFamily(gpu);
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  v12.bufferDeviceAddress = VK_TRUE;
+  const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  info.enabledExtensionCount = 2;
+  info.ppEnabledExtensionNames = extensions;
+  VkDevice featureless = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateDevice(gpu, &info, nullptr, &featureless), "vkCreateDevice");
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.queueFamilyIndex = queue.queueFamilyIndex;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateCommandPool(featureless, &pool_info, nullptr, &pool), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  vkkit::Check(vkAllocateCommandBuffers(featureless, &alloc, &cb), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
+  auto build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
+      vkGetDeviceProcAddr(featureless, "vkCmdBuildAccelerationStructuresKHR"));
+  // The build names no structure (none can be created) and builds no geometry.
+  VkAccelerationStructureBuildGeometryInfoKHR empty{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  empty.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  const VkAccelerationStructureBuildRangeInfoKHR* no_ranges = nullptr;
+  build(cb, 1, &empty, &no_ranges);
+  vkEndCommandBuffer(cb);
+  vkDestroyCommandPool(featureless, pool, nullptr);
+  vkDestroyDevice(featureless, nullptr);
+  destroy_messenger(instance.handle(), messenger, nullptr);
+}
