@@ -251,6 +251,18 @@ CORPUS_CASE(AlignmentMinimalTriangleInputs, "alignment-minimal-triangle-input-al
   scene.BuildNow({a.info, b.info, c.info, d.info}, {&range, &range, &range, &range});
 }
 
+// 16-bit components need 2-byte alignment only: a layer that holds every vertex format to 4 bytes reports this.
+CORPUS_CASE(AlignmentHalfFloatVertices, "alignment-half-float-vertices-2-aligned", "alignment",
+            "a BLAS of R16G16B16A16_SFLOAT vertices read from a 2-aligned (not 4-aligned) address", {}) {
+  Scene scene(device);
+  VkAccelerationStructureGeometryKHR half = scene.Triangles();
+  half.geometry.triangles.vertexFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+  half.geometry.triangles.vertexData.deviceAddress = scene.Address(Scene::kVertices + 2);
+  OneGeometry build(scene, half);
+  const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+  scene.BuildNow({build.info}, {&range});
+}
+
 CORPUS_CASE(AlignmentMinimalInstanceInputs, "alignment-minimal-aabb-and-instance-alignment", "alignment",
             "an AABB BLAS from the second box (8-aligned, not 16), a TLAS from the second instance (64 bytes in) "
             "and a TLAS from the second pointer (8-aligned, not 16)",

@@ -316,3 +316,19 @@ CORPUS_CASE(FeaturesNoAccelerationStructureFeature, "features-build-without-as-f
   vkDestroyDevice(featureless, nullptr);
   destroy_messenger(instance.handle(), messenger, nullptr);
 }
+
+// An app that reuses its refit info for a full rebuild and leaves srcAccelerationStructure set (to the structure
+// itself, live): only UPDATE reads the source, so the update rules do not apply.
+CORPUS_CASE(FeaturesRebuildKeepsSource, "features-rebuild-info-keeps-source", "features",
+            "a BLAS built, refitted in place, then rebuilt with mode BUILD from the refit's info (source still set)",
+            {}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  const auto ranges = Ranges(1);
+  scene.BuildNow({build.info}, {ranges.data()});
+  build.info.mode = kUpdate;
+  build.info.srcAccelerationStructure = build.info.dstAccelerationStructure;
+  scene.BuildNow({build.info}, {ranges.data()});
+  build.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  scene.BuildNow({build.info}, {ranges.data()});
+}

@@ -390,3 +390,27 @@ CORPUS_CASE(HandlesRebuildAfterRecreate, "handles-handle-value-reused-after-recr
   });
   device.Destroy(instances);
 }
+
+// srcAccelerationStructure must be a valid handle whenever it is not null, whatever the mode: an app that reuses last
+// frame's info for a rebuild keeps a source it has destroyed since.
+CORPUS_CASE(HandlesRebuildStaleSource, "handles-rebuild-keeps-destroyed-source", "handles",
+            "a BLAS rebuilt (mode BUILD) from an info whose srcAccelerationStructure names a destroyed structure",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-srcAccelerationStructure-04629"}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  build.info.srcAccelerationStructure = DestroyedStructure(device);
+  IssueTriangles(device, scene, Command::kDirect, {build.info});
+}
+
+// 03708 holds an update's source to bound memory; a rebuild does not read its (still valid) source.
+CORPUS_CASE(HandlesRebuildUnboundSource, "handles-rebuild-names-source-without-memory", "handles",
+            "a BLAS rebuilt (mode BUILD) from an info whose srcAccelerationStructure is live but on a buffer not "
+            "bound to memory",
+            {}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  UnboundStructure unbound(device);
+  build.info.srcAccelerationStructure = unbound.handle;
+  const auto ranges = Ranges(1);
+  scene.BuildNow({build.info}, {ranges.data()});
+}
