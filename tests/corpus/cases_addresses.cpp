@@ -188,6 +188,21 @@ CORPUS_CASE(InputUsageDirect, "addresses-vertices-without-build-input-usage", "a
   device.Destroy(storage);
 }
 
+CORPUS_CASE(RasterIndexBuffer, "addresses-indices-from-raster-index-buffer", "addresses",
+            "a BLAS over a raster mesh's index buffer, created with INDEX_BUFFER usage only (plus device address), "
+            "not BUILD_INPUT_READ_ONLY",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-geometry-03673"}) {
+  Scene scene(device);
+  vkkit::Buffer raster_indices = device.CreateBuffer(256, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  const uint32_t index_values[3] = {0, 1, 2};
+  std::memcpy(raster_indices.mapped, index_values, sizeof(index_values));
+  VkAccelerationStructureGeometryKHR g = scene.IndexedTriangles(VK_INDEX_TYPE_UINT32);
+  g.geometry.triangles.indexData.deviceAddress = raster_indices.address;
+  OneGeometry one(scene, g);
+  IssueOne(device, Command::kDirect, one.info, &kOne);
+  device.Destroy(raster_indices);
+}
+
 CORPUS_CASE(InputUsageIndirect, "addresses-indirect-vertices-without-build-input-usage", "addresses",
             "an indirect BLAS build reading its vertices from a buffer without BUILD_INPUT_READ_ONLY usage",
             {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-geometry-03673", kIndirectFeature}) {
