@@ -231,7 +231,73 @@ CORPUS_CASE(AlignmentPointedInstance, "alignment-pointed-instance-misaligned", "
   TlasFromPointers(device, {0, 136});
 }
 
+namespace {
+
+// One mesh's data packed back to back in one buffer, as a loader that appends every array writes it: 3 uint16
+// indices (6 bytes), 3 float vertices (36 bytes), a 3x4 transform. Where each array starts depends on the packing.
+struct PackedMesh {
+  PackedMesh(vkkit::Device& d, VkDeviceSize vertices_at, VkDeviceSize transform_at) : device(d) {
+    buffer = device.CreateBuffer(256, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+    auto* bytes = static_cast<char*>(buffer.mapped);
+    std::memset(bytes, 0, 256);
+    const uint16_t indices[3] = {0, 1, 2};
+    const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const VkTransformMatrixKHR identity = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+    std::memcpy(bytes, indices, sizeof indices);
+    std::memcpy(bytes + vertices_at, positions, sizeof positions);
+    std::memcpy(bytes + transform_at, &identity, sizeof identity);
+    geometry = VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    auto& tri = geometry.geometry.triangles;
+    tri.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+    tri.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+    tri.vertexStride = 12;
+    tri.vertexData.deviceAddress = buffer.address + vertices_at;
+    tri.maxVertex = 2;
+    tri.indexType = VK_INDEX_TYPE_UINT16;
+    tri.indexData.deviceAddress = buffer.address;
+    tri.transformData.deviceAddress = buffer.address + transform_at;
+  }
+  ~PackedMesh() { device.Destroy(buffer); }
+  // Builds the mesh into a BLAS of the scene's, submitted and waited for.
+  void Build(Scene& scene) {
+    OneGeometry build(scene, geometry);
+    const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+    scene.BuildNow({build.info}, {&range});
+  }
+  vkkit::Device& device;
+  vkkit::Buffer buffer;
+  VkAccelerationStructureGeometryKHR geometry;
+};
+
+}  // namespace
+
+CORPUS_CASE(AlignmentVerticesAfterIndices, "alignment-vertices-packed-after-16-bit-indices", "alignment",
+            "a mesh packed in one buffer: 3 uint16 indices, float vertices right after them at byte 6, a transform "
+            "at byte 48; built and submitted",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03711"}) {
+  Scene scene(device);
+  PackedMesh(device, 6, 48).Build(scene);
+}
+
+CORPUS_CASE(AlignmentTransformAfterVertices, "alignment-transform-packed-after-vertices", "alignment",
+            "a mesh packed in one buffer: 3 uint16 indices, float vertices at byte 8, the transform right after "
+            "them at byte 44; built and submitted",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03810"}) {
+  Scene scene(device);
+  PackedMesh(device, 8, 44).Build(scene);
+}
+
 // Valid twins: every input at exactly the alignment it needs, no more.
+
+CORPUS_CASE(AlignmentPackedMeshPadded, "alignment-packed-mesh-padded", "alignment",
+            "a mesh packed in one buffer with each array padded to its alignment: uint16 indices at 0, vertices at "
+            "byte 8, the transform at byte 48; built and submitted",
+            {}) {
+  Scene scene(device);
+  PackedMesh(device, 8, 48).Build(scene);
+}
 
 CORPUS_CASE(AlignmentMinimalTriangleInputs, "alignment-minimal-triangle-input-alignment", "alignment",
             "BLAS builds with vertices 4-aligned (not 8), 16-bit indices 2-aligned (not 4), a transform 16-aligned "

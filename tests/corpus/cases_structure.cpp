@@ -2,6 +2,7 @@
 // counts, flags), the geometry data (strides, formats, index types) and VkAccelerationStructureBuildRangeInfoKHR
 // (offsets, vertex counts). These VUIDs name the structure, so one case per rule through the direct command;
 // maxVertex-10774 is checked for host builds only (their indices are host memory), which lavapipe lacks.
+#include <cstring>
 #include <vector>
 
 #include "corpus.h"
@@ -360,4 +361,81 @@ CORPUS_CASE(StructureSixteenGeometriesNoPreference, "structure-16-geometries-fla
                   VK_BUILD_ACCELERATION_STRUCTURE_LOW_MEMORY_BIT_KHR);
   const auto ranges = Ranges(16);
   scene.BuildNow({many.info, other.info}, {ranges.data(), ranges.data()});
+}
+
+namespace {
+
+// A mesh whose two submeshes share one vertex buffer and one index buffer, as exporters write them: 6 vertices,
+// then 6 uint32 indices at byte 128 (submesh 1 reads vertices 3..5 through indices 0, 1, 2). The buffer is padded
+// with zeros to 8 KiB: the indices a misaligned index offset makes of these bytes (256, 512) still name vertices
+// inside it, so a build that no layer stops reads nothing out of bounds.
+struct SharedMeshBuffers {
+  explicit SharedMeshBuffers(vkkit::Device& d) : device(d) {
+    buffer = device.CreateBuffer(kSize, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+    const float positions[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 3, 0, 0, 2, 1, 0};
+    const uint32_t indices[6] = {0, 1, 2, 0, 1, 2};
+    std::memset(buffer.mapped, 0, kSize);
+    std::memcpy(buffer.mapped, positions, sizeof positions);
+    std::memcpy(static_cast<char*>(buffer.mapped) + kIndices, indices, sizeof indices);
+  }
+  ~SharedMeshBuffers() { device.Destroy(buffer); }
+  // Submesh `k`'s triangles: vertices from its first vertex, indices (when `indexed`) from the shared buffer.
+  VkAccelerationStructureGeometryKHR Submesh(uint32_t k, bool indexed) const {
+    VkAccelerationStructureGeometryKHR g{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    g.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    g.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    auto& tri = g.geometry.triangles;
+    tri.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+    tri.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+    tri.vertexStride = 12;
+    tri.vertexData.deviceAddress = buffer.address + (indexed ? 36 * k : 0);
+    tri.maxVertex = indexed ? 2 : 5;
+    tri.indexType = indexed ? VK_INDEX_TYPE_UINT32 : VK_INDEX_TYPE_NONE_KHR;
+    if (indexed) tri.indexData.deviceAddress = buffer.address + kIndices;
+    return g;
+  }
+  static constexpr VkDeviceSize kIndices = 128;
+  static constexpr VkDeviceSize kSize = 8192;
+  vkkit::Device& device;
+  vkkit::Buffer buffer;
+};
+
+}  // namespace
+
+// primitiveOffset is in bytes; the app passed the second submesh's first index (3) instead of 3 * 4.
+CORPUS_CASE(StructureIndexOffsetInIndices, "structure-submesh-index-offset-counted-in-indices", "structure",
+            "a BLAS of two indexed submeshes sharing one index buffer, the second's primitiveOffset given in indices "
+            "(3) instead of bytes (12); submitted",
+            {"VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03656"}) {
+  SharedMeshBuffers mesh(device);
+  Scene scene(device);
+  Build b(scene, {mesh.Submesh(0, true), mesh.Submesh(1, true)});
+  const VkAccelerationStructureBuildRangeInfoKHR ranges[2] = {{1, 0, 0, 0}, {1, 3, 0, 0}};
+  scene.BuildNow({b.info}, {ranges});
+}
+
+// The same mistake without indices: the second submesh's vertices start at vertex 3, passed as 3 bytes.
+CORPUS_CASE(StructureVertexOffsetInVertices, "structure-submesh-vertex-offset-counted-in-vertices", "structure",
+            "a BLAS of two non-indexed submeshes sharing one vertex buffer, the second's primitiveOffset given in "
+            "vertices (3) instead of bytes (36); submitted",
+            {"VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657"}) {
+  SharedMeshBuffers mesh(device);
+  Scene scene(device);
+  Build b(scene, {mesh.Submesh(0, false), mesh.Submesh(1, false)});
+  const VkAccelerationStructureBuildRangeInfoKHR ranges[2] = {{1, 0, 0, 0}, {1, 3, 0, 0}};
+  scene.BuildNow({b.info}, {ranges});
+}
+
+// The valid twin: the same two submeshes with their offsets in bytes.
+CORPUS_CASE(StructureSubmeshOffsetsInBytes, "structure-submesh-offsets-in-bytes", "structure",
+            "two BLASes of two submeshes sharing one vertex and one index buffer, the second submesh at byte offset "
+            "12 of the indices, or 36 of the vertices",
+            {}) {
+  SharedMeshBuffers mesh(device);
+  Scene scene(device);
+  Build indexed(scene, {mesh.Submesh(0, true), mesh.Submesh(1, true)});
+  Build plain(scene, {mesh.Submesh(0, false), mesh.Submesh(1, false)});
+  const VkAccelerationStructureBuildRangeInfoKHR indexed_ranges[2] = {{1, 0, 0, 0}, {1, 12, 0, 0}};
+  const VkAccelerationStructureBuildRangeInfoKHR plain_ranges[2] = {{1, 0, 0, 0}, {1, 36, 0, 0}};
+  scene.BuildNow({indexed.info, plain.info}, {indexed_ranges, plain_ranges});
 }
