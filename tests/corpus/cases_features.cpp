@@ -332,3 +332,25 @@ CORPUS_CASE(FeaturesRebuildKeepsSource, "features-rebuild-info-keeps-source", "f
   build.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
   scene.BuildNow({build.info}, {ranges.data()});
 }
+
+// A per-frame refit of many BLASes in one call where one info's source was never filled in (e.g. a mesh added this
+// frame takes the refit path).
+CORPUS_CASE(FeaturesBatchRefitOneWithoutSource, "features-batch-refit-one-without-source", "features",
+            "8 BLASes built, then refitted in place in one call in which the 4th info has no source",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-04630"}) {
+  Scene scene(device);
+  std::vector<TriangleBuild> builds;
+  builds.reserve(8);
+  for (int k = 0; k < 8; ++k) builds.emplace_back(scene);
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+  for (const TriangleBuild& t : builds) infos.push_back(t.info);
+  const auto ranges = Ranges(1);
+  const std::vector<const VkAccelerationStructureBuildRangeInfoKHR*> range_pointers(8, ranges.data());
+  scene.BuildNow(infos, range_pointers);
+  for (VkAccelerationStructureBuildGeometryInfoKHR& info : infos) {
+    info.mode = kUpdate;
+    info.srcAccelerationStructure = info.dstAccelerationStructure;
+  }
+  infos[3].srcAccelerationStructure = VK_NULL_HANDLE;
+  scene.BuildNow(infos, range_pointers);
+}

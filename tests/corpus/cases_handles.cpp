@@ -414,3 +414,41 @@ CORPUS_CASE(HandlesRebuildUnboundSource, "handles-rebuild-names-source-without-m
   const auto ranges = Ranges(1);
   scene.BuildNow({build.info}, {ranges.data()});
 }
+
+// A loop that assigns destinations by index modulo a table too short: infos 5 and 13 of a batch of 16 write the
+// same structure (and therefore the same memory).
+CORPUS_CASE(HandlesBatchRepeatedDst, "handles-batch-of-16-one-destination-repeated", "handles",
+            "16 BLAS builds in one call, the 14th writing the destination of the 6th",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03698",
+             "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03702"}) {
+  Scene scene(device);
+  std::vector<TriangleBuild> builds;
+  builds.reserve(16);
+  for (int k = 0; k < 16; ++k) builds.emplace_back(scene);
+  builds[13].info.dstAccelerationStructure = builds[5].info.dstAccelerationStructure;
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+  for (const TriangleBuild& t : builds) infos.push_back(t.info);
+  IssueTriangles(device, scene, Command::kDirect, infos);
+}
+
+// The rules on one structure named twice hold within one command: the same structure built by two calls of one
+// command buffer (a barrier between), and an update in a later call from what an earlier call built, are valid.
+CORPUS_CASE(HandlesSameStructureTwoCalls, "handles-same-structure-in-two-calls-of-one-command-buffer", "handles",
+            "one command buffer: a BLAS built, built again by a second call, then a third call updating another "
+            "structure from it; barriers between the calls",
+            {}) {
+  Scene scene(device);
+  TriangleBuild a(scene), b(scene);
+  VkAccelerationStructureBuildGeometryInfoKHR from_a = b.info;
+  from_a.mode = kUpdate;
+  from_a.srcAccelerationStructure = a.info.dstAccelerationStructure;
+  const auto ranges = Ranges(1);
+  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = ranges.data();
+  device.OneShot([&](VkCommandBuffer cb) {
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &a.info, &range_pointer);
+    asval_test::BuildBarrier(cb);
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &a.info, &range_pointer);
+    asval_test::BuildBarrier(cb);
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &from_a, &range_pointer);
+  });
+}
