@@ -3,6 +3,7 @@
 // instances an array of pointers names to 16, indirect addresses and strides to 4. Lavapipe has no indirect
 // builds, so the indirect cases also carry 03650.
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "corpus.h"
@@ -290,6 +291,34 @@ CORPUS_CASE(AlignmentTransformAfterVertices, "alignment-transform-packed-after-v
 }
 
 // Valid twins: every input at exactly the alignment it needs, no more.
+
+// Scratch slices packed as tightly as the device allows: each one's offset rounded up to
+// minAccelerationStructureScratchOffsetAlignment only (8 bytes on lavapipe), not to 128 or 256.
+CORPUS_CASE(AlignmentTightScratchSlices, "alignment-scratch-slices-at-minimum-alignment", "alignment",
+            "8 BLAS builds in one call, their scratch slices packed back to back in one buffer, each rounded up to "
+            "the device's minimum scratch alignment only",
+            {}) {
+  Scene scene(device);
+  const VkDeviceSize alignment = device.as_properties().minAccelerationStructureScratchOffsetAlignment;
+  std::vector<std::unique_ptr<OneGeometry>> builds;
+  std::vector<VkDeviceSize> offsets;
+  VkDeviceSize size = 0;
+  for (int k = 0; k < 8; ++k) {
+    builds.push_back(std::make_unique<OneGeometry>(scene, scene.Triangles()));
+    offsets.push_back(size);
+    size = asval_test::RoundUp(size + asval_test::DriverSizes(device, builds.back()->info, {1}).buildScratchSize,
+                               alignment);
+  }
+  vkkit::Buffer scratch = device.CreateBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+  for (int k = 0; k < 8; ++k) {
+    builds[k]->info.scratchData.deviceAddress = scratch.address + offsets[k];
+    infos.push_back(builds[k]->info);
+  }
+  const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+  scene.BuildNow(infos, std::vector<const VkAccelerationStructureBuildRangeInfoKHR*>(8, &range));
+  device.Destroy(scratch);
+}
 
 CORPUS_CASE(AlignmentPackedMeshPadded, "alignment-packed-mesh-padded", "alignment",
             "a mesh packed in one buffer with each array padded to its alignment: uint16 indices at 0, vertices at "

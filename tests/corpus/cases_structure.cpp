@@ -439,3 +439,16 @@ CORPUS_CASE(StructureSubmeshOffsetsInBytes, "structure-submesh-offsets-in-bytes"
   const VkAccelerationStructureBuildRangeInfoKHR plain_ranges[2] = {{1, 0, 0, 0}, {1, 36, 0, 0}};
   scene.BuildNow({indexed.info, plain.info}, {indexed_ranges, plain_ranges});
 }
+
+// Empty structures, as an engine builds them before its first mesh or instance is loaded: 03788 asks for a geometry
+// array only when geometryCount is not 0, and a top-level build of 0 instances still has its one geometry.
+CORPUS_CASE(StructureEmptyBuilds, "structure-empty-blas-and-empty-tlas", "structure",
+            "a BLAS built with geometryCount 0 and no geometry array, and a TLAS built over 0 instances", {}) {
+  Scene scene(device);
+  Build empty_bottom(scene, {});
+  empty_bottom.info.pGeometries = nullptr;
+  Build empty_top(scene, {scene.Instances()}, kTop, {0});
+  const VkAccelerationStructureBuildRangeInfoKHR none{0, 0, 0, 0};
+  scene.BuildNow({empty_bottom.info}, {&none});
+  scene.BuildNow({empty_top.info}, {&none});
+}
