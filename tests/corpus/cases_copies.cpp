@@ -367,6 +367,34 @@ CORPUS_CASE(SerializationRoundTrip, "copies-valid-serialization-round-trip", "co
   device.Destroy(instances);
 }
 
+CORPUS_CASE(CompactIntoRecycledMemory, "copies-valid-compact-into-recycled-memory", "copies",
+            "a BLAS compacted every frame into a new exact-size structure at the same offset of one VkDeviceMemory "
+            "(the last frame's structure and buffer destroyed, addresses reused), the compacted copy then cloned to "
+            "the next offset",
+            {}) {
+  Inputs inputs(device);
+  Blas original(device, inputs);
+  const uint64_t size = BuildAndQuery(device, original, Compactable(), kCompactedSize);
+  const VkDeviceSize stride = asval_test::RoundUp(size, 256);
+  SharedMemory memory(device, 1 << 20);
+  for (int frame = 0; frame < 3; ++frame) {
+    vkkit::Buffer storage =
+        memory.Bind(256, 2 * stride, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+    const VkAccelerationStructureKHR compacted =
+        memory.Structure(storage, 0, size, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
+    const VkAccelerationStructureKHR clone =
+        memory.Structure(storage, stride, size, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
+    Submit(device, [&](VkCommandBuffer cb) {
+      CmdCopy(device, cb, original.handle(), compacted, kCompact);
+      AsBarrier(cb);
+      CmdCopy(device, cb, compacted, clone, kClone);
+    });
+    memory.DestroyStructure(compacted);
+    memory.DestroyStructure(clone);
+    memory.DestroyBuffer(storage);
+  }
+}
+
 CORPUS_CASE(CloneChainSameSubmission, "copies-valid-clone-chain-in-one-submission", "copies",
             "a BLAS built, cloned, and the clone cloned again, in one command buffer with barriers; then the clones "
             "refitted",
