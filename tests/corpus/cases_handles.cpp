@@ -452,3 +452,48 @@ CORPUS_CASE(HandlesSameStructureTwoCalls, "handles-same-structure-in-two-calls-o
     device.CmdBuildAccelerationStructuresKHR(cb, 1, &from_a, &range_pointer);
   });
 }
+
+// Instances referencing structures by address, some inactive (reference 0), as a scene with hidden objects keeps
+// them: the references that 03709 follows are the live ones only.
+CORPUS_CASE(HandlesTlasInactiveInstances, "handles-tlas-with-inactive-instances", "handles",
+            "a TLAS built over 4 instances, two referencing live BLASes and two inactive (reference 0)", {}) {
+  asval_test::Inputs inputs(device);
+  asval_test::Blas a(device, inputs), b(device, inputs);
+  asval_test::Tlas tlas(device);
+  device.OneShot([&](VkCommandBuffer cb) {
+    a.Build(cb, asval_test::Shape{});
+    b.Build(cb, asval_test::Shape{});
+  });
+  vkkit::Buffer instances = device.CreateBuffer(4 * sizeof(VkAccelerationStructureInstanceKHR),
+                                                VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  const VkDeviceAddress references[4] = {a.address(), 0, b.address(), 0};
+  for (int k = 0; k < 4; ++k) {
+    VkAccelerationStructureInstanceKHR instance{};
+    for (int row = 0; row < 3; ++row) instance.transform.matrix[row][row] = 1.0f;
+    instance.transform.matrix[0][3] = 4.0f * static_cast<float>(k);
+    instance.mask = 0xff;
+    instance.accelerationStructureReference = references[k];
+    std::memcpy(static_cast<char*>(instances.mapped) + k * sizeof instance, &instance, sizeof instance);
+  }
+  device.OneShot([&](VkCommandBuffer cb) {
+    tlas.Record(cb, instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  });
+  device.Destroy(instances);
+}
+
+// Two structures sub-allocated in one VkBuffer (as memory allocators place them), built by one call: distinct
+// structures at distinct bytes, however close.
+CORPUS_CASE(HandlesTwoBlasOneBuffer, "handles-two-blas-in-one-buffer-one-call", "handles",
+            "two BLASes created in one storage buffer (offsets 0 and 32768) built by one call", {}) {
+  Scene scene(device);
+  TriangleBuild first(scene), second(scene);
+  asval_test::SharedMemory memory(device, 1 << 16);
+  vkkit::Buffer storage = memory.Bind(0, 1 << 16, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+  const VkDeviceSize size = asval_test::DriverSizes(device, first.info, {1}).accelerationStructureSize;
+  first.info.dstAccelerationStructure =
+      memory.Structure(storage, 0, size, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
+  second.info.dstAccelerationStructure =
+      memory.Structure(storage, 1 << 15, size, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
+  const auto ranges = Ranges(1);
+  scene.BuildNow({first.info, second.info}, {ranges.data(), ranges.data()});
+}
