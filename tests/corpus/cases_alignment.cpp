@@ -358,6 +358,40 @@ CORPUS_CASE(AlignmentHalfFloatVertices, "alignment-half-float-vertices-2-aligned
   scene.BuildNow({build.info}, {&range});
 }
 
+// Byte and packed formats (both supported for builds on lavapipe): byte components need no alignment at all, a packed
+// format's whole 4-byte texel does.
+CORPUS_CASE(AlignmentByteAndPackedVertices, "alignment-byte-vertices-odd-address-packed-4-aligned", "alignment",
+            "a BLAS of R8G8B8A8_SNORM vertices read from an odd address, and one of A2B10G10R10_UNORM_PACK32 vertices "
+            "from a 4-aligned (not 8-aligned) address",
+            {}) {
+  Scene scene(device);
+  VkAccelerationStructureGeometryKHR bytes = scene.Triangles();
+  bytes.geometry.triangles.vertexFormat = VK_FORMAT_R8G8B8A8_SNORM;
+  bytes.geometry.triangles.vertexStride = 4;
+  bytes.geometry.triangles.vertexData.deviceAddress = scene.Address(Scene::kVertices + 1);
+  VkAccelerationStructureGeometryKHR packed = scene.Triangles();
+  packed.geometry.triangles.vertexFormat = VK_FORMAT_A2B10G10R10_UNORM_PACK32;
+  packed.geometry.triangles.vertexStride = 4;
+  packed.geometry.triangles.vertexData.deviceAddress = scene.Address(Scene::kVertices + 4);
+  OneGeometry a(scene, bytes), b(scene, packed);
+  const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+  scene.BuildNow({a.info, b.info}, {&range, &range});
+}
+
+// A packed format's texel is one 4-byte word: the newest wording of 03711 aligns a packed format's vertices to the
+// whole texel, so 2 bytes past a 4-byte boundary is misaligned.
+CORPUS_CASE(AlignmentPackedVerticesMisaligned, "alignment-packed-vertices-2-aligned", "alignment",
+            "a BLAS of A2B10G10R10_UNORM_PACK32 vertices read from a 2-aligned (not 4-aligned) address",
+            {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03711"}) {
+  Scene scene(device);
+  VkAccelerationStructureGeometryKHR packed = scene.Triangles();
+  packed.geometry.triangles.vertexFormat = VK_FORMAT_A2B10G10R10_UNORM_PACK32;
+  packed.geometry.triangles.vertexStride = 4;
+  OneGeometry build(scene, packed);
+  build.geometry.geometry.triangles.vertexData.deviceAddress += 2;
+  build.Record(device, Command::kDirect);
+}
+
 CORPUS_CASE(AlignmentMinimalInstanceInputs, "alignment-minimal-aabb-and-instance-alignment", "alignment",
             "an AABB BLAS from the second box (8-aligned, not 16), a TLAS from the second instance (64 bytes in) "
             "and a TLAS from the second pointer (8-aligned, not 16)",

@@ -3,6 +3,8 @@
 // (offsets, vertex counts). These VUIDs name the structure, so one case per rule through the direct command;
 // maxVertex-10774 is checked for host builds only (their indices are host memory), which lavapipe lacks.
 #include <cstring>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "corpus.h"
@@ -233,6 +235,18 @@ CORPUS_CASE(StructureVertexOffsetMisaligned, "structure-vertex-offset-not-compon
   b.Record(device, {1, 6, 0, 0});
 }
 
+// For a packed vertex format the offset is held to the whole texel (the newest wording of 03657), not to a component.
+CORPUS_CASE(StructurePackedVertexOffset, "structure-packed-vertex-offset-not-texel-multiple", "structure",
+            "non-indexed A2B10G10R10_UNORM_PACK32 triangles with primitiveOffset 2",
+            {"VUID-VkAccelerationStructureBuildRangeInfoKHR-primitiveOffset-03657"}) {
+  Scene scene(device);
+  VkAccelerationStructureGeometryKHR packed = scene.Triangles();
+  packed.geometry.triangles.vertexFormat = VK_FORMAT_A2B10G10R10_UNORM_PACK32;
+  packed.geometry.triangles.vertexStride = 4;
+  Build b(scene, {packed});
+  b.Record(device, {1, 2, 0, 0});
+}
+
 CORPUS_CASE(StructureTransformOffsetMisaligned, "structure-transform-offset-not-16", "structure",
             "triangles with a transform, transformOffset 24",
             {"VUID-VkAccelerationStructureBuildRangeInfoKHR-transformOffset-03658"}) {
@@ -451,4 +465,27 @@ CORPUS_CASE(StructureEmptyBuilds, "structure-empty-blas-and-empty-tlas", "struct
   const VkAccelerationStructureBuildRangeInfoKHR none{0, 0, 0, 0};
   scene.BuildNow({empty_bottom.info}, {&none});
   scene.BuildNow({empty_top.info}, {&none});
+}
+
+// Every vertex format the specification requires for acceleration-structure builds, each at its natural stride
+// (2D positions included): none lacks the format feature, every stride is a multiple of its component size.
+CORPUS_CASE(StructureMandatoryVertexFormats, "structure-mandatory-vertex-formats", "structure",
+            "six BLASes, one per mandatory vertex format (R32G32_SFLOAT, R32G32B32_SFLOAT, R16G16_SFLOAT, "
+            "R16G16B16A16_SFLOAT, R16G16_SNORM, R16G16B16A16_SNORM) at its natural stride",
+            {}) {
+  Scene scene(device);
+  const std::pair<VkFormat, VkDeviceSize> formats[] = {
+      {VK_FORMAT_R32G32_SFLOAT, 8},       {VK_FORMAT_R32G32B32_SFLOAT, 12}, {VK_FORMAT_R16G16_SFLOAT, 4},
+      {VK_FORMAT_R16G16B16A16_SFLOAT, 8}, {VK_FORMAT_R16G16_SNORM, 4},      {VK_FORMAT_R16G16B16A16_SNORM, 8}};
+  std::vector<std::unique_ptr<Build>> builds;
+  std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos;
+  for (const auto& [format, stride] : formats) {
+    VkAccelerationStructureGeometryKHR g = scene.Triangles();  // the positions' bytes, read in each format
+    g.geometry.triangles.vertexFormat = format;
+    g.geometry.triangles.vertexStride = stride;
+    builds.push_back(std::make_unique<Build>(scene, std::vector<VkAccelerationStructureGeometryKHR>{g}));
+    infos.push_back(builds.back()->info);
+  }
+  const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+  scene.BuildNow(infos, std::vector<const VkAccelerationStructureBuildRangeInfoKHR*>(infos.size(), &range));
 }
