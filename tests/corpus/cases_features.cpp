@@ -354,3 +354,42 @@ CORPUS_CASE(FeaturesBatchRefitOneWithoutSource, "features-batch-refit-one-withou
   infos[3].srcAccelerationStructure = VK_NULL_HANDLE;
   scene.BuildNow(infos, range_pointers);
 }
+
+// Pool flags other than PROTECTED leave a command buffer unprotected: a per-frame transient, resettable pool whose
+// one command buffer is reset and re-recorded every frame.
+CORPUS_CASE(FeaturesTransientResettablePool, "features-builds-in-transient-resettable-pool", "features",
+            "a BLAS built, then refitted 3 times, each frame re-recording one command buffer of a TRANSIENT | "
+            "RESET_COMMAND_BUFFER pool",
+            {}) {
+  Scene scene(device);
+  TriangleBuild build(scene);
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool_info.queueFamilyIndex = 0;  // lavapipe's only queue family, the one vkkit::Device uses
+  VkCommandPool pool = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateCommandPool(device.handle(), &pool_info, nullptr, &pool), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  vkkit::Check(vkAllocateCommandBuffers(device.handle(), &alloc, &cb), "vkAllocateCommandBuffers");
+  const auto ranges = Ranges(1);
+  const VkAccelerationStructureBuildRangeInfoKHR* range_pointer = ranges.data();
+  for (int frame = 0; frame < 4; ++frame) {
+    vkkit::Check(vkResetCommandBuffer(cb, 0), "vkResetCommandBuffer");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &build.info, &range_pointer);
+    vkkit::Check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    vkkit::Check(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
+    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+    build.info.mode = kUpdate;  // every later frame refits
+    build.info.srcAccelerationStructure = build.info.dstAccelerationStructure;
+  }
+  vkDestroyCommandPool(device.handle(), pool, nullptr);
+}
