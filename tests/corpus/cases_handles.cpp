@@ -433,7 +433,7 @@ CORPUS_CASE(HandlesBatchRepeatedDst, "handles-batch-of-16-one-destination-repeat
 
 // The rules on one structure named twice hold within one command: the same structure built by two calls of one
 // command buffer (a barrier between), and an update in a later call from what an earlier call built, are valid.
-CORPUS_CASE(HandlesSameStructureTwoCalls, "handles-same-structure-in-two-calls-of-one-command-buffer", "handles",
+CORPUS_CASE(HandlesSameStructureTwoCalls, "handles-one-blas-in-three-calls-of-one-command-buffer", "handles",
             "one command buffer: a BLAS built, built again by a second call, then a third call updating another "
             "structure from it; barriers between the calls",
             {}) {
