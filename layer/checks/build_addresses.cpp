@@ -18,6 +18,7 @@ namespace {
 [[gnu::noinline]] bool ValidateGeometryInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                                               BufferMemo& memo) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (!GeometriesWalkable(ctx, info)) return false;  // past maxGeometryCount: type-03793 says it, nothing is walked
   ReportingJudge judge{ctx};
   GeometryFactsReader facts(ctx.state);
   InputWindow window;

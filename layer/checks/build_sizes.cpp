@@ -64,6 +64,7 @@ bool GeometryQueryable(const DeviceState& state, const VkAccelerationStructureGe
 // Out of line: walked only for infos the geometry pass flagged.
 [[gnu::noinline]] bool ValidateInstanceCounts(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (!GeometriesWalkable(ctx, info)) return false;  // past maxGeometryCount: type-03793 says it, nothing is walked
   if (cmd.is_indirect() ? !cmd.max_primitive_counts || !cmd.max_primitive_counts[i] : !cmd.ranges || !cmd.ranges[i]) {
     return false;  // counts not given: another rule's business
   }
