@@ -217,7 +217,7 @@ def main():
     ap.add_argument("--driver-files", default=LVP_ICD, help="the ICD manifest (VK_DRIVER_FILES); default lavapipe")
     ap.add_argument("--valid-only", action="append", default=[], metavar="CONFIG",
                     help="run only the valid cases under CONFIG (on a GPU that an uncaught invalid build may hang)")
-    ap.add_argument("--cases", help="only the cases whose name contains this")
+    ap.add_argument("--cases", help="only the cases whose name starts with this")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 2)
     ap.add_argument("--json", help="write every result here")
     ap.add_argument("--verdicts", help="the committed verdicts to compare with")
@@ -227,7 +227,7 @@ def main():
     aliases = load_aliases()
     cases = list_cases(os.path.abspath(args.corpus), args.scene and os.path.abspath(args.scene))
     if args.cases:
-        cases = [c for c in cases if args.cases in c["name"]]
+        cases = [c for c in cases if c["name"].startswith(args.cases)]
     configs = configurations(os.path.abspath(args.layer_path), args.config, args.driver_files)
     kversion = khronos_version()
     if args.no_khronos or not kversion:
