@@ -64,15 +64,16 @@ def registry_families():
 
 
 def list_cases(corpus, scene):
-    """Every case with its label. A fault case of the corpus program counts in the family that asval's registry
-    gives its first VUID (what switching that family off loses); a valid case in the family it names."""
+    """Every case with its label. A case counts in the family it names when asval's registry gives one of its VUIDs
+    that family (what switching the family off loses), else in its first VUID's family."""
     families = registry_families()
     cases = []
     out = subprocess.run([corpus, "--list"], stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
     for c in json.loads(out):
         c["command"] = [corpus, c["name"]]
-        if c["expected"]:
-            c["family"] = families.get(c["expected"][0], c["family"])
+        label_families = [families[v] for v in c["expected"] if v in families]
+        if label_families and c["family"] not in label_families:
+            c["family"] = label_families[0]
         cases.append(c)
     if scene:
         out = subprocess.run([scene, "--list-faults"], stdout=subprocess.PIPE, universal_newlines=True,
