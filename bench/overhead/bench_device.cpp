@@ -38,6 +38,15 @@ void PrintDevice(VkPhysicalDevice gpu) {
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
   vkGetPhysicalDeviceProperties2(gpu, &props);
   std::printf("device: %s; driver: %s %s\n", props.properties.deviceName, driver.driverName, driver.driverInfo);
+  // The layers the loader activated (it answers this deprecated query with the instance's layers): the runner
+  // checks that each configuration ran with the layers it names, and with no other.
+  uint32_t count = 0;
+  vkEnumerateDeviceLayerProperties(gpu, &count, nullptr);
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateDeviceLayerProperties(gpu, &count, layers.data());
+  std::printf("layers:");
+  for (uint32_t i = 0; i < count; ++i) std::printf("%s%s", i ? "," : " ", layers[i].layerName);
+  std::printf("\n");
 }
 
 }  // namespace

@@ -31,6 +31,14 @@ def entry_for(baseline: Dict, key: str, build_type: str) -> (Optional[Dict], str
     return entry, ""
 
 
+def out_of_bounds(entry: Dict, row: str, measured: float, threshold: float) -> bool:
+    """Whether a row moved more than the threshold either way (a drop that large is as unexpected)."""
+    base = entry["rows"].get(row)
+    if base is None or base["added_ir_per_call"] <= 0:
+        return False
+    return abs(measured / base["added_ir_per_call"] - 1) > threshold
+
+
 def check(entry: Dict, added: Dict[str, float], calls: Dict[str, int], threshold: float) -> int:
     """Prints one line per row; returns 0, or 1 when a row grew more than the threshold."""
     failed = 0
@@ -61,6 +69,10 @@ def check(entry: Dict, added: Dict[str, float], calls: Dict[str, int], threshold
 
 def update(path: str, baseline: Dict, key: str, build_type: str, driver: str, added: Dict[str, float],
            calls: Dict[str, int]) -> None:
+    baseline["about"] = ("asval's added instructions per call (callgrind, the calling thread, asval at default "
+                         "settings minus no layer, run_overhead.py --quick call counts), per system and build type. "
+                         "Checked by run_overhead.py --guard (ctest overhead_guard); rewritten only by "
+                         "run_overhead.py --update-baseline (docs/performance.md).")
     baseline.setdefault("threshold", THRESHOLD)
     baseline.setdefault("systems", {})[key] = {
         "build_type": build_type,

@@ -28,6 +28,20 @@ _NS = re.compile(r"^ns_per_call: ([0-9.]+) calls: (\d+)$", re.M)
 _FPS = re.compile(r"frames 1\.\.\d+ \((?:refits|trace only)\) ([0-9.]+) fps")
 _MESSAGES = re.compile(r"^validation messages: (\d+) error\(s\), (\d+) warning\(s\)$", re.M)
 _DEVICE = re.compile(r"^device: (.*; driver: .*)$", re.M)
+_LAYERS = re.compile(r"^layers:(.*)$", re.M)
+
+
+def _check_layers(argv: List[str], proc: subprocess.CompletedProcess, env: Dict[str, str]) -> None:
+    """The overhead programs print the layers the loader activated: a run with other layers than its
+    configuration names measured something else. (The scene prints none; its rows are wall time only.)"""
+    m = _LAYERS.search(proc.stdout)
+    if not m:
+        return
+    active = [x for x in m.group(1).strip().split(",") if x]
+    wanted = [x for x in env.get("VK_INSTANCE_LAYERS", "").split(":") if x]
+    if active != wanted:
+        raise RunError(f"{' '.join(argv)}: ran with layers {active or 'none'}, its configuration names "
+                       f"{wanted or 'none'}")
 
 
 def _describe(argv: List[str], proc: subprocess.CompletedProcess) -> str:
@@ -49,13 +63,20 @@ def _check_messages(argv: List[str], proc: subprocess.CompletedProcess, tolerate
     return count
 
 
+def _cwd(env: Dict[str, str]) -> str:
+    """The private HOME: asval reads a vk_layer_settings.txt in the working directory when no other settings file
+    is found, and the caller's (the repository root has one) must not count."""
+    return env["HOME"]
+
+
 def run_wall(row: Row, argv: List[str], env: Dict[str, str], tolerate: bool = False,
              timeout: float = 600) -> WallResult:
-    proc = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=timeout)
+    proc = subprocess.run(argv, env=env, cwd=_cwd(env), capture_output=True, text=True, timeout=timeout)
     # The overhead programs exit with 3 when a layer reported something; _check_messages decides.
     if proc.returncode not in (0, 3):
         raise RunError(_describe(argv, proc))
     messages = _check_messages(argv, proc, tolerate)
+    _check_layers(argv, proc, env)
     device = _DEVICE.search(proc.stdout)
     if row.kind == "frame":
         m = _FPS.search(proc.stdout)
@@ -93,10 +114,11 @@ def run_callgrind(row: Row, argv: List[str], env: Dict[str, str], calls: int, to
         out = os.path.join(out_dir, "cg")
         full = [valgrind() or "valgrind", "--tool=callgrind", "--instr-atstart=no", "--separate-threads=yes",
                 f"--callgrind-out-file={out}"] + argv
-        proc = subprocess.run(full, env=env, capture_output=True, text=True, timeout=timeout)
+        proc = subprocess.run(full, env=env, cwd=_cwd(env), capture_output=True, text=True, timeout=timeout)
         if proc.returncode not in (0, 3):
             raise RunError(_describe(full, proc))
         _check_messages(full, proc, tolerate)
+        _check_layers(full, proc, env)
         main_thread = [p for p in glob.glob(out + "-*") if p.endswith("-01")]
         total = _totals(main_thread[0]) if main_thread else 0
         if total == 0:

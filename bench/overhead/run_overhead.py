@@ -87,8 +87,18 @@ def measure_callgrind(rows, configs, args, base_env) -> Dict[Tuple[str, str], fl
 
     def one(job):
         row, config = job
-        return run_callgrind(row, row.argv(args.build, args.quick), overhead_env.environment(base_env, config),
-                             row.measured_calls(args.quick), overhead_env.tolerates_messages(config))
+
+        def run():
+            return run_callgrind(row, row.argv(args.build, args.quick), overhead_env.environment(base_env, config),
+                                 row.measured_calls(args.quick), overhead_env.tolerates_messages(config))
+
+        try:
+            return run()
+        except RunError as e:
+            # Once, in eleven guard runs, an asval run counted as if no layer were loaded (the active-layer check
+            # did not exist yet): a failed run is tried once more, and fails for good the second time.
+            print(f"run_overhead: {row.name}, {config.name}: {e}\nrun_overhead: trying once more", file=sys.stderr)
+            return run()
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         results = list(pool.map(one, jobs))
@@ -159,6 +169,16 @@ def run_guard(args: argparse.Namespace, base_env: Dict[str, str]) -> int:
     ir = measure_callgrind(rows, configs, args, base_env)
     added = {row.name: ir[(row.name, "asval")] - ir[(row.name, "none")] for row in rows}
     calls = {row.name: row.measured_calls(True) for row in rows}
+    if args.guard:
+        # A row out of bounds is measured again before it fails: the counts repeat run to run (docs/performance.md),
+        # so a real growth shows twice, and a one-off disturbance does not fail CI.
+        threshold = baseline.get("threshold", overhead_guard.THRESHOLD)
+        suspect = [row for row in rows if overhead_guard.out_of_bounds(entry, row.name, added[row.name], threshold)]
+        if suspect:
+            print("overhead guard: measuring again: " + ", ".join(row.name for row in suspect))
+            again = measure_callgrind(suspect, configs, args, base_env)
+            for row in suspect:
+                added[row.name] = again[(row.name, "asval")] - again[(row.name, "none")]
     print(f"overhead guard, system {key} ({build_type}): asval's added instructions per call (callgrind, "
           "calling thread, asval minus no layer)")
     if args.update_baseline:
