@@ -24,7 +24,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Count(VkDebugUtilsMessageSeverityFlagBitsEXT seve
 
 VkDebugUtilsMessengerCreateInfoEXT MessengerInfo(BenchDevice* bench) {
   VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+  info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
   // Validation messages only: the loader's general ones (e.g. that VK_LOADER_LAYERS_DISABLE switched a layer
   // off) say nothing about the calls measured.
   info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;

@@ -58,8 +58,9 @@ def _check_messages(argv: List[str], proc: subprocess.CompletedProcess, tolerate
         raise RunError(_describe(argv, proc))
     count = int(m.group(1)) + int(m.group(2))
     if count and not tolerate:
+        tail = (proc.stdout + proc.stderr).strip().splitlines()[-8:]
         raise RunError(f"{' '.join(argv)}: the layers reported {m.group(1)} error(s), {m.group(2)} warning(s) "
-                       f"on calls that are valid:\n  " + "\n  ".join((proc.stdout + proc.stderr).strip().splitlines()[-8:]))
+                       f"on calls that are valid:\n  " + "\n  ".join(tail))
     return count
 
 

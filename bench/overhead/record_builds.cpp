@@ -54,8 +54,8 @@ int Run(int argc, char** argv) {
   std::vector<std::vector<VkAccelerationStructureGeometryKHR>> own_geometries;
   std::vector<std::vector<VkAccelerationStructureBuildRangeInfoKHR>> own_ranges;
   for (uint32_t k = 0; k < infos_per_call; ++k) {
-    destinations.push_back(
-        device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize));
+    destinations.push_back(device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                              sizes.accelerationStructureSize));
     infos[k].dstAccelerationStructure = destinations.back().handle;
     infos[k].scratchData.deviceAddress = scratch.address + slice * k;
     if (!own_buffers) continue;

@@ -221,7 +221,8 @@ def main(argv: List[str]) -> int:
             "rounds": args.rounds,
             "rows": [{"row": row.name, "kind": row.kind, "config": c.name,
                       "wall_ns_min": min(wall[(row.name, c.name)]) if (row.name, c.name) in wall else None,
-                      "wall_ns_median": statistics.median(wall[(row.name, c.name)]) if (row.name, c.name) in wall else None,
+                      "wall_ns_median": (statistics.median(wall[(row.name, c.name)])
+                                         if (row.name, c.name) in wall else None),
                       "ir_per_call": ir.get((row.name, c.name))}
                      for row in rows for c in configs],
         }

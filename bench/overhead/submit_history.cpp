@@ -52,7 +52,8 @@ VkCommandBuffer Begin(VkDevice device, VkCommandPool pool) {
 void BuildBarrier(VkCommandBuffer cb) {
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
-  barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  barrier.dstAccessMask =
+      VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
   const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR;
   vkCmdPipelineBarrier(cb, stage, stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
@@ -88,13 +89,14 @@ int Run(int argc, char** argv) {
   device.GetAccelerationStructureBuildSizesKHR(handle, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info,
                                                &triangle.range.primitiveCount, &sizes);
   const VkDeviceSize alignment = device.as_properties().minAccelerationStructureScratchOffsetAlignment;
-  const VkDeviceSize needed = sizes.buildScratchSize > sizes.updateScratchSize ? sizes.buildScratchSize : sizes.updateScratchSize;
+  const VkDeviceSize needed =
+      sizes.buildScratchSize > sizes.updateScratchSize ? sizes.buildScratchSize : sizes.updateScratchSize;
   const VkDeviceSize slice = (needed + alignment - 1) / alignment * alignment;
   vkkit::Buffer scratch = device.CreateBuffer(slice * structures, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   std::vector<vkkit::AccelerationStructure> blases;
   for (uint32_t i = 0; i < structures; ++i) {
-    blases.push_back(
-        device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize));
+    blases.push_back(device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                        sizes.accelerationStructureSize));
   }
   const VkAccelerationStructureBuildRangeInfoKHR* range = &triangle.range;
   auto record = [&](VkCommandBuffer cb, VkBuildAccelerationStructureModeKHR mode) {
@@ -102,7 +104,8 @@ int Run(int argc, char** argv) {
       VkAccelerationStructureBuildGeometryInfoKHR one = info;
       one.mode = mode;
       one.dstAccelerationStructure = blases[i].handle;
-      one.srcAccelerationStructure = mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR ? blases[i].handle : VK_NULL_HANDLE;
+      const bool update = mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+      one.srcAccelerationStructure = update ? blases[i].handle : VK_NULL_HANDLE;
       one.scratchData.deviceAddress = scratch.address + slice * i;
       device.CmdBuildAccelerationStructuresKHR(cb, 1, &one, &range);
     }
