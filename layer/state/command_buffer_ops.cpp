@@ -81,6 +81,7 @@ std::string DescribeOrigin(const OpOrigin& origin) {
 void OpBatch::Clear() {
   ops_.clear();
   geometries_.clear();
+  applied_snapshots_.clear();
 }
 
 namespace {

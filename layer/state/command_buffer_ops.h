@@ -9,6 +9,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -18,6 +19,7 @@
 namespace asval {
 
 class CaptureLog;  // capture_log.h
+struct BuildSnapshot;  // history.h
 
 // The command an operation came from (for messages and ordinals).
 enum class OpCommand : uint8_t {
@@ -175,6 +177,18 @@ class OpBatch {
   void Swap(OpBatch& other) noexcept {
     ops_.swap(other.ops_);
     geometries_.swap(other.geometries_);
+    applied_snapshots_.swap(other.applied_snapshots_);
+  }
+
+  // A submitted batch remembers, per operation, the parameter snapshot it left in its destination when it was
+  // last applied (history_apply.cpp): applied again, a build that finds that snapshot still there shares it on a
+  // pointer comparison instead of comparing its parameters again. Sized when a recording is published; written
+  // only with the history store's lock held (the published batch is otherwise immutable, and every submission
+  // applies under that lock). Null for other batches (host operations, tests): they compare.
+  void RememberSnapshots() { applied_snapshots_.assign(ops_.size(), nullptr); }
+  std::shared_ptr<const BuildSnapshot>* AppliedSnapshot(const AsOp& op) const {
+    const std::size_t i = static_cast<std::size_t>(&op - ops_.data());
+    return i < applied_snapshots_.size() ? &applied_snapshots_[i] : nullptr;
   }
 
   // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
@@ -195,6 +209,7 @@ class OpBatch {
 
   std::vector<AsOp> ops_;
   std::vector<GeometryRecord> geometries_;
+  mutable std::vector<std::shared_ptr<const BuildSnapshot>> applied_snapshots_;
 };
 
 

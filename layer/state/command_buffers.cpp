@@ -28,6 +28,7 @@ void CommandBufferState::Publish() {
     std::shared_ptr<RecordedOps> fresh = spare_ ? std::move(spare_) : std::make_shared<RecordedOps>();
     fresh->batch.Swap(recording);  // the recording takes the spare's (cleared) storage
     recording.Clear();
+    fresh->batch.RememberSnapshots();
     fresh->lost = recording_lost;
     fresh->capture_logs = executed_capture_logs;
     if (capture_log) fresh->capture_logs.push_back(capture_log);

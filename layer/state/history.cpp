@@ -30,13 +30,19 @@ AsHistory HistoryStore::Get(VkAccelerationStructureKHR as) const {
   return AsHistory{};
 }
 
-const AsHistory* HistoryStore::Find(VkAccelerationStructureKHR as) const {
-  const auto it = histories_.find(as);
-  return it == histories_.end() ? nullptr : &it->second.history;
-}
-
-void HistoryStore::Index(VkAccelerationStructureKHR as, const MemorySpan& span) {
+void HistoryStore::Index(uint32_t record, VkAccelerationStructureKHR as) {
+  Record& r = records_[record];
+  const MemorySpan& span = r.history().span;
+  r.alone_epoch = 0;
   if (span.memory == VK_NULL_HANDLE || span.begin >= span.end) return;
+  bool overlaps = false;
+  ForEachOverlapping(span, as, [&](VkAccelerationStructureKHR) { overlaps = true; });
+  // A new overlap makes every structure's "alone" note stale: they search again at their next write.
+  if (overlaps) {
+    ++overlap_epoch_;
+  } else {
+    r.alone_epoch = overlap_epoch_;
+  }
   spans_.emplace(SpanKey{span.memory, span.begin}, SpanEntry{as, span.end});
   VkDeviceSize& longest = longest_span_[span.memory];
   longest = std::max(longest, span.end - span.begin);
@@ -54,39 +60,117 @@ void HistoryStore::Unindex(VkAccelerationStructureKHR as, const MemorySpan& span
   // longest_span_ stays an upper bound; it only widens the window a query scans.
 }
 
-void HistoryStore::Set(VkAccelerationStructureKHR as, AsHistory history, Transaction* txn) {
-  auto it = histories_.find(as);
+uint32_t HistoryStore::Insert(VkAccelerationStructureKHR as, AsHistory history, uint64_t version) {
+  uint32_t record;
+  if (!free_records_.empty()) {
+    record = free_records_.back();
+    free_records_.pop_back();
+    records_[record] = Record(std::move(history), version);
+  } else {
+    record = static_cast<uint32_t>(records_.size());
+    records_.emplace_back(std::move(history), version);
+  }
+  index_.Insert(reinterpret_cast<uint64_t>(as), record);
+  Index(record, as);
+  return record;
+}
+
+uint32_t HistoryStore::Set(VkAccelerationStructureKHR as, AsHistory history, Transaction* txn) {
+  if (as == VK_NULL_HANDLE) return kNoRecord;  // not a structure: nothing can ask for its record
+  const uint32_t record = RecordOf(as);
+  if (record != kNoRecord) {
+    SetAt(record, as, std::move(history), txn);
+    return record;
+  }
   const uint64_t version = ++version_counter_;
   if (txn) {
-    Transaction::Entry entry{Transaction::Kind::kHistory};
-    entry.as = as;
-    if (it != histories_.end()) {
-      entry.old_history = it->second.history;
-      entry.old_version = it->second.version;
-    }
-    entry.version = version;
-    txn->entries_.push_back(std::move(entry));
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->histories_.emplace_back(as, version, 0, false, AsHistory{});
   }
-  if (it == histories_.end()) {
-    Index(as, history.span);
-    histories_.emplace(as, Record{std::move(history), version});
-    return;
+  return Insert(as, std::move(history), version);
+}
+
+void HistoryStore::SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHistory history, Transaction* txn) {
+  Record& r = records_[record];
+  const uint64_t version = ++version_counter_;
+  const MemorySpan& old_span = r.history().span;
+  const bool moved = old_span.memory != history.span.memory || old_span.begin != history.span.begin ||
+                     old_span.end != history.span.end;
+  if (moved) Unindex(as, old_span);
+  if (txn) {
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->histories_.emplace_back(as, version, r.version, true, std::move(r.history()));
   }
-  const MemorySpan& old_span = it->second.history.span;
-  if (old_span.memory != history.span.memory || old_span.begin != history.span.begin ||
-      old_span.end != history.span.end) {
-    Unindex(as, old_span);
-    Index(as, history.span);
+  r.history() = std::move(history);
+  r.version = version;
+  if (moved) Index(record, as);
+}
+
+AsHistory& HistoryStore::Rewrite(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
+                                  const std::shared_ptr<const BuildSnapshot>& build) {
+  Record& r = records_[record];
+  const uint64_t version = ++version_counter_;
+  AsHistory* h = &r.history();
+  if (txn && txn->id_ != 0 && r.flipped_by != txn->id_) {
+    // The other slot holds what undo no longer needs (a transaction over, or one that never flipped this record).
+    AsHistory& next = r.slots[r.current ^ 1];
+    next.span = h->span;
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kFlip, static_cast<uint32_t>(txn->flips_.size())});
+    txn->flips_.push_back(Transaction::FlipChange{as, version, r.version});
+    r.current ^= 1;
+    r.flipped_by = txn->id_;
+    h = &next;
+  } else if (txn) {
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->histories_.emplace_back(as, version, r.version, true, std::move(*h));  // leaves the span as it was
   }
-  it->second.history = std::move(history);
-  it->second.version = version;
+  r.version = version;
+  h->kind = HistoryKind::kNeverBuilt;
+  h->unknown_reason = UnknownReason::kNone;
+  // A structure rebuilt or updated every frame finds the snapshot it had two writes ago in the slot: no reference
+  // count changes.
+  if (h->build != build) h->build = build;
+  h->clobbered.reset();
+  h->generation = NextGeneration();
+  h->serialization_size = 0;
+  h->serialization_size_generation = 0;
+  h->activity.reset();
+  return *h;
+}
+
+std::unique_ptr<Transaction> HistoryStore::TakeTransaction() {
+  if (spare_transactions_.empty()) {
+    auto txn = std::make_unique<Transaction>();
+    txn->id_ = ++transaction_counter_;
+    return txn;
+  }
+  std::unique_ptr<Transaction> txn = std::move(spare_transactions_.back());
+  spare_transactions_.pop_back();
+  txn->id_ = ++transaction_counter_;
+  return txn;
+}
+
+void HistoryStore::ReturnTransaction(std::unique_ptr<Transaction> txn) {
+  // A few are enough: more are in use at once only while app callbacks submit from within submissions.
+  if (spare_transactions_.size() < 4) spare_transactions_.push_back(std::move(txn));
 }
 
 void HistoryStore::Forget(VkAccelerationStructureKHR as) {
-  auto it = histories_.find(as);
-  if (it == histories_.end()) return;
-  Unindex(as, it->second.history.span);
-  histories_.erase(it);
+  const uint32_t record = RecordOf(as);
+  if (record == kNoRecord) return;
+  Unindex(as, records_[record].history().span);
+  index_.Erase(reinterpret_cast<uint64_t>(as));
+  records_[record] = Record{};  // releases its snapshot and activity now
+  free_records_.push_back(record);
+}
+
+void HistoryStore::Push(Transaction* txn, Transaction::Kind kind, uint64_t blob_id) {
+  if (!txn) return;
+  txn->entries_.push_back(Transaction::Entry{kind, static_cast<uint32_t>(txn->blobs_.size())});
+  txn->blobs_.push_back(blob_id);
 }
 
 uint64_t HistoryStore::AddBlob(SerializedBlob blob, Transaction* txn) {
@@ -97,11 +181,7 @@ uint64_t HistoryStore::AddBlob(SerializedBlob blob, Transaction* txn) {
   }
   blob.id = ++blob_counter_;
   blob.valid = true;
-  if (txn) {
-    Transaction::Entry entry{Transaction::Kind::kBlobAdded};
-    entry.blob_id = blob.id;
-    txn->entries_.push_back(std::move(entry));
-  }
+  Push(txn, Transaction::Kind::kBlobAdded, blob.id);
   blobs_.push_back(std::move(blob));
   return blob_counter_;
 }
@@ -134,11 +214,7 @@ void HistoryStore::InvalidateBlobsOverlapping(const MemorySpan& span, Transactio
   for (SerializedBlob& blob : blobs_) {
     if (!blob.valid || !Overlaps(blob.span, span)) continue;
     blob.valid = false;
-    if (txn) {
-      Transaction::Entry entry{Transaction::Kind::kBlobInvalidated};
-      entry.blob_id = blob.id;
-      txn->entries_.push_back(std::move(entry));
-    }
+    Push(txn, Transaction::Kind::kBlobInvalidated, blob.id);
   }
 }
 
@@ -146,11 +222,7 @@ void HistoryStore::InvalidateHostBlob(const void* host_address, Transaction* txn
   for (SerializedBlob& blob : blobs_) {
     if (!blob.valid || blob.host_address != host_address) continue;
     blob.valid = false;
-    if (txn) {
-      Transaction::Entry entry{Transaction::Kind::kBlobInvalidated};
-      entry.blob_id = blob.id;
-      txn->entries_.push_back(std::move(entry));
-    }
+    Push(txn, Transaction::Kind::kBlobInvalidated, blob.id);
   }
 }
 
@@ -158,11 +230,7 @@ void HistoryStore::InvalidateAllBlobs(Transaction* txn) {
   for (SerializedBlob& blob : blobs_) {
     if (!blob.valid) continue;
     blob.valid = false;
-    if (txn) {
-      Transaction::Entry entry{Transaction::Kind::kBlobInvalidated};
-      entry.blob_id = blob.id;
-      txn->entries_.push_back(std::move(entry));
-    }
+    Push(txn, Transaction::Kind::kBlobInvalidated, blob.id);
   }
 }
 
@@ -171,14 +239,13 @@ void HistoryStore::SetSlot(VkQueryPool pool, uint32_t query, const QuerySlot& sl
   const uint64_t version = ++version_counter_;
   auto it = slots_.find(key);
   if (txn) {
-    Transaction::Entry entry{Transaction::Kind::kSlot};
-    entry.slot_key = key;
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kSlot, static_cast<uint32_t>(txn->slots_.size())});
+    Transaction::SlotChange change{key, version, 0, std::nullopt};
     if (it != slots_.end()) {
-      entry.old_slot = it->second.slot;
-      entry.old_version = it->second.version;
+      change.old_slot = it->second.slot;
+      change.old_version = it->second.version;
     }
-    entry.version = version;
-    txn->entries_.push_back(std::move(entry));
+    txn->slots_.push_back(std::move(change));
   }
   slots_[key] = SlotRecord{slot, version};
 }
@@ -200,7 +267,11 @@ void HistoryStore::ForgetMemory(VkDeviceMemory memory) {
                blobs_.end());
   auto it = spans_.lower_bound(SpanKey{memory, 0});
   while (it != spans_.end() && it->first.memory == memory) {
-    if (auto h = histories_.find(it->second.as); h != histories_.end()) h->second.history.span = MemorySpan{};
+    if (const uint32_t record = RecordOf(it->second.as); record != kNoRecord) {
+      // Both slots: an undo that switches back must not index bytes that are gone.
+      records_[record].slots[0].span = MemorySpan{};
+      records_[record].slots[1].span = MemorySpan{};
+    }
     it = spans_.erase(it);
   }
   longest_span_.erase(memory);
@@ -210,33 +281,50 @@ void HistoryStore::Undo(Transaction& txn) {
   for (auto e = txn.entries_.rbegin(); e != txn.entries_.rend(); ++e) {
     switch (e->kind) {
       case Transaction::Kind::kHistory: {
-        auto it = histories_.find(e->as);
-        if (it == histories_.end() || it->second.version != e->version) break;  // changed since: keep the newer
-        if (e->old_history) {
-          AsHistory old = std::move(*e->old_history);
-          Set(e->as, std::move(old), nullptr);
+        Transaction::HistoryChange& change = txn.histories_[e->at];
+        const uint32_t record = RecordOf(change.as);
+        if (record == kNoRecord || records_[record].version != change.version) break;  // changed since: keep it
+        if (change.existed) {
+          SetAt(record, change.as, std::move(change.old_history), nullptr);
           // The version it had before, so that an earlier entry of this transaction for it still matches.
-          histories_.find(e->as)->second.version = e->old_version;
+          records_[record].version = change.old_version;
         } else {
-          Forget(e->as);
+          Forget(change.as);
         }
         break;
       }
-      case Transaction::Kind::kBlobAdded:
-        blobs_.erase(std::remove_if(blobs_.begin(), blobs_.end(),
-                                    [&](const SerializedBlob& b) { return b.id == e->blob_id; }),
+      case Transaction::Kind::kFlip: {
+        const Transaction::FlipChange& flip = txn.flips_[e->at];
+        const uint32_t record = RecordOf(flip.as);
+        if (record == kNoRecord || records_[record].version != flip.version) break;  // changed since: keep it
+        Record& r = records_[record];
+        const MemorySpan& now = r.history().span;
+        const MemorySpan& before = r.slots[r.current ^ 1].span;
+        const bool moved = now.memory != before.memory || now.begin != before.begin || now.end != before.end;
+        if (moved) Unindex(flip.as, now);
+        r.current ^= 1;
+        r.version = flip.old_version;
+        r.flipped_by = 0;
+        if (moved) Index(record, flip.as);
+        break;
+      }
+      case Transaction::Kind::kBlobAdded: {
+        const uint64_t id = txn.blobs_[e->at];
+        blobs_.erase(std::remove_if(blobs_.begin(), blobs_.end(), [&](const SerializedBlob& b) { return b.id == id; }),
                      blobs_.end());
         break;
+      }
       case Transaction::Kind::kBlobInvalidated:
         for (SerializedBlob& blob : blobs_) {
-          if (blob.id == e->blob_id) blob.valid = true;
+          if (blob.id == txn.blobs_[e->at]) blob.valid = true;
         }
         break;
       case Transaction::Kind::kSlot: {
-        auto it = slots_.find(e->slot_key);
-        if (it == slots_.end() || it->second.version != e->version) break;
-        if (e->old_slot) {
-          it->second = SlotRecord{*e->old_slot, e->old_version};
+        const Transaction::SlotChange& change = txn.slots_[e->at];
+        auto it = slots_.find(change.key);
+        if (it == slots_.end() || it->second.version != change.version) break;
+        if (change.old_slot) {
+          it->second = SlotRecord{*change.old_slot, change.old_version};
         } else {
           slots_.erase(it);
         }
@@ -244,7 +332,7 @@ void HistoryStore::Undo(Transaction& txn) {
       }
     }
   }
-  txn.entries_.clear();
+  txn.Clear();
 }
 
 }  // namespace asval

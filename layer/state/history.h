@@ -26,6 +26,7 @@
 #include "build_activity.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
+#include "handle_index.h"
 #include "memory_range.h"
 
 namespace asval {
@@ -106,26 +107,62 @@ struct QuerySlot {
 
 class HistoryStore;
 
-// Undo log of one submission's changes.
+// Undo log of one submission's changes. Entries are plain values in flat arrays: a replaced record's old history
+// is moved in, not copied, and the arrays keep their capacity when the log is reused (HistoryStore keeps spare
+// logs for the submissions to come, so that a steady stream of submissions allocates nothing here).
 class Transaction {
  public:
   bool empty() const { return entries_.empty(); }
-  void ReserveMore(std::size_t entries) { entries_.reserve(entries_.size() + entries); }
+  void ReserveMore(std::size_t entries) {
+    entries_.reserve(entries_.size() + entries);
+    flips_.reserve(flips_.size() + entries);
+  }
+  // Forgets every entry (the changes stay), keeping the capacity.
+  void Clear() {
+    entries_.clear();
+    histories_.clear();
+    flips_.clear();
+    blobs_.clear();
+    slots_.clear();
+  }
 
  private:
   friend class HistoryStore;
-  enum class Kind : uint8_t { kHistory, kBlobAdded, kBlobInvalidated, kSlot };
+  enum class Kind : uint8_t { kHistory, kFlip, kBlobAdded, kBlobInvalidated, kSlot };
+  // In the order the changes were made; `at` indexes the array of its kind.
   struct Entry {
     Kind kind;
-    VkAccelerationStructureKHR as = VK_NULL_HANDLE;
-    std::optional<AsHistory> old_history;  // kHistory: nullopt when the record did not exist
-    uint64_t version = 0;                  // kHistory / kSlot: the version this transaction wrote
-    uint64_t old_version = 0;              // ... and the one it replaced (restored with the old value)
-    uint64_t blob_id = 0;                  // kBlobAdded / kBlobInvalidated
-    std::pair<VkQueryPool, uint32_t> slot_key{};
-    std::optional<QuerySlot> old_slot;
+    uint32_t at;
   };
+  struct HistoryChange {
+    HistoryChange(VkAccelerationStructureKHR as_, uint64_t version_, uint64_t old_version_, bool existed_,
+                  AsHistory&& old)
+        : as(as_), version(version_), old_version(old_version_), existed(existed_), old_history(std::move(old)) {}
+    VkAccelerationStructureKHR as;
+    uint64_t version;      // the version this transaction wrote
+    uint64_t old_version;  // ... and the one it replaced (restored with the old record)
+    bool existed;          // false: the record did not exist (undone by forgetting it)
+    AsHistory old_history;
+  };
+  // A record rewritten into its other history slot (HistoryStore::Rewrite): undone by switching back.
+  struct FlipChange {
+    VkAccelerationStructureKHR as;
+    uint64_t version;
+    uint64_t old_version;
+  };
+  struct SlotChange {
+    std::pair<VkQueryPool, uint32_t> key;
+    uint64_t version;
+    uint64_t old_version;
+    std::optional<QuerySlot> old_slot;  // nullopt when the slot did not exist
+  };
+  // Given by HistoryStore::TakeTransaction for each submission (0: a log made elsewhere, which never flips).
+  uint64_t id_ = 0;
   std::vector<Entry> entries_;
+  std::vector<HistoryChange> histories_;
+  std::vector<FlipChange> flips_;
+  std::vector<uint64_t> blobs_;  // kBlobAdded / kBlobInvalidated: the blob's id
+  std::vector<SlotChange> slots_;
 };
 
 class HistoryStore {
@@ -136,9 +173,38 @@ class HistoryStore {
 
   // The record of a structure; never built when the layer has none.
   AsHistory Get(VkAccelerationStructureKHR as) const;
-  const AsHistory* Find(VkAccelerationStructureKHR as) const;
-  // Replaces the record (and indexes its span). txn may be null (host operations are not rolled back).
-  void Set(VkAccelerationStructureKHR as, AsHistory history, Transaction* txn);
+  const AsHistory* Find(VkAccelerationStructureKHR as) const {
+    const uint32_t record = RecordOf(as);
+    return record == kNoRecord ? nullptr : &records_[record].history();
+  }
+  // Replaces the record (and indexes its span). txn may be null (host operations are not rolled back). Returns
+  // the record's index (kNoRecord for VK_NULL_HANDLE, which gets none).
+  uint32_t Set(VkAccelerationStructureKHR as, AsHistory history, Transaction* txn);
+
+  // The same by record index, for an operation that reads a record and then replaces it (one lookup, not
+  // three). An index stays valid until its structure is forgotten (Forget, Undo of its creation); kNoRecord: the
+  // structure has no record.
+  static constexpr uint32_t kNoRecord = HandleIndex::kNone;
+  uint32_t RecordOf(VkAccelerationStructureKHR as) const {
+    return index_.Find(reinterpret_cast<uint64_t>(as));
+  }
+  const AsHistory& HistoryAt(uint32_t record) const { return records_[record].history(); }
+  // Replaces the history of record (of structure as) like Set.
+  void SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHistory history, Transaction* txn);
+  // For an operation that rewrites the contents of a structure whose record knows its span: the record's history
+  // becomes never built with `build` as its snapshot, without clobber, activity or serialization size, with the
+  // same span and a new generation, for the caller to fill in; the old one is kept for txn's undo. The span does not change, so it is not re-indexed.
+  // The first rewrite of a record by a transaction writes the record's other history slot and keeps the old one
+  // where it was (undo switches back: nothing is moved or copied into the log); later ones in the same
+  // transaction, and those without one, move the old history into the log (or drop it).
+  AsHistory& Rewrite(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
+                     const std::shared_ptr<const BuildSnapshot>& build);
+
+  // A submission's undo log: a spare one (keeping the capacity an earlier submission gave it) or a new one; and
+  // back when the submission is over (cleared by the caller, outside the lock: the old histories it releases
+  // may hold the last references to captured bytes).
+  std::unique_ptr<Transaction> TakeTransaction();
+  void ReturnTransaction(std::unique_ptr<Transaction> txn);
   // Destroyed: its history ends; a new structure with the same handle value starts fresh.
   void Forget(VkAccelerationStructureKHR as);
   uint64_t NextGeneration() { return ++generation_counter_; }
@@ -146,8 +212,16 @@ class HistoryStore {
   // Structures whose span overlaps `span` (other than `except`).
   template <typename F>
   void ForEachOverlapping(const MemorySpan& span, VkAccelerationStructureKHR except, F&& f) const;
+  // Structures whose span overlaps the span of `record` (of structure as), without searching when no other
+  // structure's span has come to overlap it since the last search found none (most structures own their
+  // bytes: then nothing is searched at all).
+  template <typename F>
+  void ForEachOverlappingRecord(uint32_t record, VkAccelerationStructureKHR as, F&& f);
+  // True when ForEachOverlappingRecord(record) would find nothing without searching.
+  bool Alone(uint32_t record) const { return records_[record].alone_epoch == overlap_epoch_; }
 
   // Serialized bytes.
+  bool has_blobs() const { return !blobs_.empty(); }
   uint64_t AddBlob(SerializedBlob blob, Transaction* txn);
   const SerializedBlob* FindHostBlob(const void* host_address) const;
   // The latest valid blob of device memory that starts at span.begin of span.memory; null when none.
@@ -171,7 +245,7 @@ class HistoryStore {
   // Rolls a transaction back. Entries that a later change already replaced are left alone.
   void Undo(Transaction& txn);
 
-  std::size_t size() const { return histories_.size(); }
+  std::size_t size() const { return index_.size(); }
 
   // Counters, readable without the lock.
   mutable std::atomic<uint64_t> ops_applied{0};
@@ -180,8 +254,21 @@ class HistoryStore {
 
  private:
   struct Record {
-    AsHistory history;
+    Record() = default;
+    Record(AsHistory history, uint64_t version_) : version(version_) { slots[0] = std::move(history); }
+    AsHistory& history() { return slots[current]; }
+    const AsHistory& history() const { return slots[current]; }
+
+    // The history now (slots[current]) and, after a rewrite by a transaction still undoable, the one before it.
+    AsHistory slots[2];
+    uint8_t current = 0;
     uint64_t version = 0;
+    // The transaction (Transaction::id_) whose undo may switch `current` back; 0: none.
+    uint64_t flipped_by = 0;
+    // No other structure's span overlapped this one's when overlap_epoch_ had this value (0: not known). Valid
+    // while overlap_epoch_ keeps it: a span that comes to overlap another bumps the epoch, and removing spans
+    // never makes new overlaps.
+    uint64_t alone_epoch = 0;
   };
   struct SpanKey {
     VkDeviceMemory memory;
@@ -206,11 +293,20 @@ class HistoryStore {
   };
 
   void Unindex(VkAccelerationStructureKHR as, const MemorySpan& span);
-  void Index(VkAccelerationStructureKHR as, const MemorySpan& span);
+  // Indexes record's span, and notes whether it overlaps another structure's.
+  void Index(uint32_t record, VkAccelerationStructureKHR as);
+  uint32_t Insert(VkAccelerationStructureKHR as, AsHistory history, uint64_t version);
+  void Push(Transaction* txn, Transaction::Kind kind, uint64_t blob_id);
 
   mutable std::mutex mutex_;
-  std::unordered_map<VkAccelerationStructureKHR, Record, HandleHash<VkAccelerationStructureKHR>> histories_;
+  // Records by index (stable while the structure has one), found through index_; freed indices are reused.
+  HandleIndex index_;
+  std::vector<Record> records_;
+  std::vector<uint32_t> free_records_;
+  std::vector<std::unique_ptr<Transaction>> spare_transactions_;
   std::multimap<SpanKey, SpanEntry> spans_;
+  uint64_t overlap_epoch_ = 1;
+  uint64_t transaction_counter_ = 0;
   std::unordered_map<VkDeviceMemory, VkDeviceSize, HandleHash<VkDeviceMemory>> longest_span_;
   std::vector<SerializedBlob> blobs_;
   std::unordered_map<std::pair<VkQueryPool, uint32_t>, SlotRecord, SlotKeyHash> slots_;
@@ -229,6 +325,17 @@ void HistoryStore::ForEachOverlapping(const MemorySpan& span, VkAccelerationStru
     if (it->first.memory != span.memory || it->first.begin >= span.end) break;
     if (it->second.end > span.begin && it->second.as != except) f(it->second.as);
   }
+}
+
+template <typename F>
+void HistoryStore::ForEachOverlappingRecord(uint32_t record, VkAccelerationStructureKHR as, F&& f) {
+  if (Alone(record)) return;
+  bool any = false;
+  ForEachOverlapping(records_[record].history().span, as, [&](VkAccelerationStructureKHR other) {
+    any = true;
+    f(other);
+  });
+  if (!any) records_[record].alone_epoch = overlap_epoch_;
 }
 
 }  // namespace asval

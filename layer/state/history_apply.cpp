@@ -8,17 +8,29 @@ namespace asval {
 
 namespace {
 
+// GeometryRecord's ==, without a branch per member: every applied build compares its geometries with the
+// snapshot it may share.
+bool SameGeometry(const GeometryRecord& a, const GeometryRecord& b) {
+  const uint32_t differ = (a.type ^ b.type) | (a.flags ^ b.flags) | (a.vertex_format ^ b.vertex_format) |
+                          (a.index_type ^ b.index_type) | (a.max_vertex ^ b.max_vertex) |
+                          (a.primitive_count ^ b.primitive_count) | (a.has_transform ^ b.has_transform) |
+                          (a.primitive_count_known ^ b.primitive_count_known);
+  return differ == 0;
+}
+
+bool SameGeometries(const std::vector<GeometryRecord>& snapshot, const GeometryRecord* geometries, uint32_t count) {
+  if (snapshot.size() != count) return false;
+  for (uint32_t j = 0; j < count; ++j) {
+    if (!SameGeometry(snapshot[j], geometries[j])) return false;
+  }
+  return true;
+}
+
 // Builds with identical parameters share one snapshot, so that a structure rebuilt or updated every frame
 // costs no allocation (the snapshot's origin then names the first of the identical builds).
 bool SameParameters(const BuildSnapshot& snapshot, const OpBatch& batch, const AsOp& op) {
-  if (snapshot.flags != op.flags || snapshot.type != op.type || snapshot.geometries.size() != op.geometry_count) {
-    return false;
-  }
-  const GeometryRecord* geometries = batch.GeometriesOf(op);
-  for (uint32_t j = 0; j < op.geometry_count; ++j) {
-    if (snapshot.geometries[j] != geometries[j]) return false;
-  }
-  return true;
+  return snapshot.flags == op.flags && snapshot.type == op.type &&
+         SameGeometries(snapshot.geometries, batch.GeometriesOf(op), op.geometry_count);
 }
 
 std::shared_ptr<const BuildSnapshot> MakeSnapshot(const OpBatch& batch, const AsOp& op) {
@@ -36,6 +48,11 @@ std::shared_ptr<const BuildSnapshot> MakeSnapshot(const OpBatch& batch, const As
 std::shared_ptr<const BuildSnapshot> UpdateSnapshot(const AsHistory& src, const OpBatch& batch, const AsOp& op) {
   if (src.kind == HistoryKind::kBuilt && src.build) {
     const BuildSnapshot& s = *src.build;
+    if (op.origin.command != OpCommand::kCmdBuildIndirect) {
+      // Every primitive count known (only indirect builds keep theirs on the device): a plain comparison.
+      if (SameParameters(s, batch, op)) return src.build;
+      return MakeSnapshot(batch, op);
+    }
     bool same = s.flags == op.flags && s.type == op.type && s.geometries.size() == op.geometry_count;
     const GeometryRecord* geometries = batch.GeometriesOf(op);
     for (uint32_t j = 0; same && j < op.geometry_count; ++j) {
@@ -51,31 +68,39 @@ std::shared_ptr<const BuildSnapshot> UpdateSnapshot(const AsHistory& src, const 
   return MakeSnapshot(batch, op);
 }
 
+// A structure an operation writes: its record (kNoRecord when it has none yet) and the history it gets.
+struct Written {
+  uint32_t record = HistoryStore::kNoRecord;
+  AsHistory history;
+};
+
 // The written structure's new record, with its span, a fresh generation and no clobber; nullopt for a handle
 // that is not a live structure (destroyed before the command buffer was submitted: an invalid submission whose
 // record would otherwise outlive the structure and greet a new one with the same handle value). A structure's
 // span never changes while it lives (its buffer's binding is immutable), so a known one is reused rather than
 // looked up again in the shadow maps; records end when structures are destroyed, so one with a record lives.
-std::optional<AsHistory> Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
-  AsHistory h;
-  const AsHistory* old = store.Find(as);
-  if (old && old->span.memory != VK_NULL_HANDLE) {
-    h.span = old->span;
-  } else if (!old && !state.acceleration_structures.contains(as)) {
+std::optional<Written> Fresh(const DeviceState& state, HistoryStore& store, VkAccelerationStructureKHR as) {
+  std::optional<Written> w(std::in_place);
+  w->record = store.RecordOf(as);
+  if (w->record != HistoryStore::kNoRecord && store.HistoryAt(w->record).span.memory != VK_NULL_HANDLE) {
+    w->history.span = store.HistoryAt(w->record).span;
+  } else if (w->record == HistoryStore::kNoRecord && !state.acceleration_structures.contains(as)) {
     return std::nullopt;
   } else if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) {
-    h.span = *span;
+    w->history.span = *span;
   }
-  h.generation = store.NextGeneration();
-  return h;
+  w->history.generation = store.NextGeneration();
+  return w;
 }
 
 // A write of `span` by `op` leaves every other structure there with contents that are not what was built, and
-// any serialized bytes there modified.
+// any serialized bytes there modified. writer_record: the written structure's record (its span is `span`), whose
+// store remembers whether anything overlaps it; kNoRecord for serialized bytes.
 void ClobberOverlapping(HistoryStore& store, const MemorySpan& span, VkAccelerationStructureKHR writer,
-                        const AsOp& op, Transaction* txn) {
+                        uint32_t writer_record, const AsOp& op, Transaction* txn) {
   if (span.memory == VK_NULL_HANDLE) return;
-  store.InvalidateBlobsOverlapping(span, txn);
+  if (store.has_blobs()) store.InvalidateBlobsOverlapping(span, txn);
+  if (writer_record != HistoryStore::kNoRecord && store.Alone(writer_record)) return;  // most structures
   // Collected first: Set() may re-index while the span index is being walked otherwise.
   VkAccelerationStructureKHR hits[16];
   std::size_t count = 0;
@@ -83,7 +108,7 @@ void ClobberOverlapping(HistoryStore& store, const MemorySpan& span, VkAccelerat
   while (more) {
     more = false;
     count = 0;
-    store.ForEachOverlapping(span, writer, [&](VkAccelerationStructureKHR as) {
+    const auto collect = [&](VkAccelerationStructureKHR as) {
       const AsHistory* h = store.Find(as);
       if (!h || h->kind == HistoryKind::kNeverBuilt || h->clobbered) return;
       if (count < 16) {
@@ -91,7 +116,12 @@ void ClobberOverlapping(HistoryStore& store, const MemorySpan& span, VkAccelerat
       } else {
         more = true;
       }
-    });
+    };
+    if (writer_record != HistoryStore::kNoRecord) {
+      store.ForEachOverlappingRecord(writer_record, writer, collect);
+    } else {
+      store.ForEachOverlapping(span, writer, collect);
+    }
     for (std::size_t i = 0; i < count; ++i) {
       AsHistory h = *store.Find(hits[i]);
       h.clobbered = Clobber{op.origin, writer};
@@ -100,12 +130,19 @@ void ClobberOverlapping(HistoryStore& store, const MemorySpan& span, VkAccelerat
   }
 }
 
-void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, AsHistory h, const AsOp& op,
+void SetWritten(HistoryStore& store, VkAccelerationStructureKHR dst, Written& written, const AsOp& op,
                 Transaction* txn) {
-  const MemorySpan span = h.span;
-  if (h.kind == HistoryKind::kUnknown) store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
-  store.Set(dst, std::move(h), txn);
-  ClobberOverlapping(store, span, dst, op, txn);
+  const MemorySpan span = written.history.span;
+  if (written.history.kind == HistoryKind::kUnknown) {
+    store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+  }
+  uint32_t record = written.record;
+  if (record == HistoryStore::kNoRecord) {
+    record = store.Set(dst, std::move(written.history), txn);
+  } else {
+    store.SetAt(record, dst, std::move(written.history), txn);
+  }
+  ClobberOverlapping(store, span, dst, record, op, txn);
 }
 
 // An indirect build's captured range infos, judged when its submission completes. An update takes its source's
@@ -173,38 +210,81 @@ std::shared_ptr<BuildActivity> HostActivity(const AsOp& op) {
   return node;
 }
 
+// The parameters a build or update leaves in dst (dst_record: dst's record, kNoRecord when it has none): shared
+// with the source's or the previous build's when they are the same, so that steady frames allocate nothing.
+// Returned by reference, so that finding the same snapshot again copies no shared pointer: to the batch's memo of
+// this operation (which a rewrite of the histories leaves alone), or to `storage` for batches without one.
+const std::shared_ptr<const BuildSnapshot>& BuiltSnapshot(const HistoryStore& store, const OpBatch& batch,
+                                                          const AsOp& op, uint32_t dst_record,
+                                                          std::shared_ptr<const BuildSnapshot>& storage) {
+  // Most updates are in place: the source's record is the destination's, already found.
+  const uint32_t base_record = !op.is_update() ? dst_record : op.src == op.dst ? dst_record : store.RecordOf(op.src);
+  const AsHistory* base = base_record != HistoryStore::kNoRecord ? &store.HistoryAt(base_record) : nullptr;
+  // What this operation left last time it was applied: its own parameters (made from them, or compared equal), so
+  // finding it again in the source (update) or in dst (build) is finding the same parameters.
+  std::shared_ptr<const BuildSnapshot>* memo = batch.AppliedSnapshot(op);
+  if (memo && *memo && base && base->build == *memo && (!op.is_update() || base->kind == HistoryKind::kBuilt)) {
+    return *memo;
+  }
+  std::shared_ptr<const BuildSnapshot>& built = memo ? *memo : storage;
+  if (op.is_update()) {
+    built = base ? UpdateSnapshot(*base, batch, op) : MakeSnapshot(batch, op);
+  } else {
+    built = base && base->build && SameParameters(*base->build, batch, op) ? base->build : MakeSnapshot(batch, op);
+  }
+  return built;
+}
+
+// The activity a build leaves in dst: filled now (host builds) or when the submission completes (captured device
+// builds); null when not captured. Reads the histories as they are before the build (its source's activity, the
+// instances' structures').
+std::shared_ptr<BuildActivity> BuiltActivity(const DeviceState& state, const HistoryStore& store, const AsOp& op,
+                                             SubmissionCaptures* captures) {
+  if (!op.capture_log) return nullptr;
+  if (op.origin.command == OpCommand::kHostBuild) return HostActivity(op);
+  return captures ? CapturedActivity(state, store, op, *captures) : nullptr;
+}
+
 void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
                 Transaction* txn, SubmissionCaptures* captures) {
-  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  const uint32_t record = store.RecordOf(op.dst);
+  if (record != HistoryStore::kNoRecord && !op.geometries_unreadable &&
+      store.HistoryAt(record).span.memory != VK_NULL_HANDLE) {
+    // The common case, a structure built before: its record is rewritten in place, its span known and unchanged.
+    std::shared_ptr<const BuildSnapshot> storage;
+    const std::shared_ptr<const BuildSnapshot>& build = BuiltSnapshot(store, batch, op, record, storage);
+    std::shared_ptr<BuildActivity> activity = BuiltActivity(state, store, op, captures);
+    AsHistory& h = store.Rewrite(record, op.dst, txn, build);
+    h.kind = HistoryKind::kBuilt;
+    if (activity) h.activity = std::move(activity);
+    // Most structures own their bytes, and most devices hold no serialized bytes the layer tracks.
+    if (store.has_blobs() || !store.Alone(record)) {
+      const MemorySpan span = h.span;
+      ClobberOverlapping(store, span, op.dst, record, op, txn);
+    }
+    return;
+  }
+  std::optional<Written> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
-  AsHistory& h = *fresh;
+  AsHistory& h = fresh->history;
   if (op.geometries_unreadable) {
     h.kind = HistoryKind::kUnknown;
     h.unknown_reason = UnknownReason::kUnreadableBuild;
-    SetWritten(store, op.dst, std::move(h), op, txn);
+    SetWritten(store, op.dst, *fresh, op, txn);
     return;
   }
   h.kind = HistoryKind::kBuilt;
-  if (op.is_update()) {
-    const AsHistory* src = store.Find(op.src);
-    h.build = src ? UpdateSnapshot(*src, batch, op) : MakeSnapshot(batch, op);
-  } else {
-    const AsHistory* old = store.Find(op.dst);
-    h.build = old && old->build && SameParameters(*old->build, batch, op) ? old->build : MakeSnapshot(batch, op);
-  }
-  if (op.capture_log && op.origin.command == OpCommand::kHostBuild) {
-    h.activity = HostActivity(op);
-  } else if (captures && op.capture_log) {
-    h.activity = CapturedActivity(state, store, op, *captures);
-  }
-  SetWritten(store, op.dst, std::move(h), op, txn);
+  std::shared_ptr<const BuildSnapshot> storage;
+  h.build = BuiltSnapshot(store, batch, op, fresh->record, storage);
+  h.activity = BuiltActivity(state, store, op, captures);
+  SetWritten(store, op.dst, *fresh, op, txn);
 }
 
 void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
   const AsHistory src = store.Get(op.src);
-  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  std::optional<Written> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
-  AsHistory& h = *fresh;
+  AsHistory& h = fresh->history;
   if (src.kind == HistoryKind::kBuilt) {
     h.kind = HistoryKind::kBuilt;
     h.build = src.build;
@@ -214,7 +294,7 @@ void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Tr
     h.kind = HistoryKind::kUnknown;
     h.unknown_reason = UnknownReason::kCopiedFromUnknown;
   }
-  SetWritten(store, op.dst, std::move(h), op, txn);
+  SetWritten(store, op.dst, *fresh, op, txn);
 }
 
 // Whether one submission already reads capture (log, blob) of a serialization or deserialization: the device then
@@ -261,7 +341,7 @@ void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn, Submi
   // up to the buffer's end are taken as overwritten (they then restore nothing: safe), but no structure is
   // reported as clobbered on a guess.
   if (size_known) {
-    ClobberOverlapping(store, blob.span, VK_NULL_HANDLE, op, txn);
+    ClobberOverlapping(store, blob.span, VK_NULL_HANDLE, HistoryStore::kNoRecord, op, txn);
   } else {
     store.InvalidateBlobsOverlapping(blob.span, txn);
   }
@@ -282,9 +362,9 @@ void ApplySerialize(HistoryStore& store, const AsOp& op, Transaction* txn, Submi
 
 void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn,
                       SubmissionCaptures* captures) {
-  std::optional<AsHistory> fresh = Fresh(state, store, op.dst);
+  std::optional<Written> fresh = Fresh(state, store, op.dst);
   if (!fresh) return;
-  AsHistory& h = *fresh;
+  AsHistory& h = fresh->history;
   const SerializedBlob* blob = nullptr;
   // Host bytes are trusted to be what the layer saw serialized by their hash, now. Device memory may have been
   // rewritten by commands the layer does not follow (vkCmdCopyBuffer, vkCmdUpdateBuffer, vkCmdFillBuffer, copies
@@ -327,7 +407,7 @@ void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp&
       captures->deserializes.push_back(std::move(check));
     }
   }
-  SetWritten(store, op.dst, std::move(h), op, txn);
+  SetWritten(store, op.dst, *fresh, op, txn);
 }
 
 void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn) {
@@ -347,12 +427,12 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
   // The structures that exist now: one created later cannot have been written by this command buffer.
   const auto live = state.acceleration_structures.snapshot();
   for (const auto& [as, record] : live) {
-    std::optional<AsHistory> fresh = Fresh(state, store, as);
+    std::optional<Written> fresh = Fresh(state, store, as);
     if (!fresh) continue;
-    fresh->kind = HistoryKind::kUnknown;
-    fresh->unknown_reason = UnknownReason::kLostOperations;
+    fresh->history.kind = HistoryKind::kUnknown;
+    fresh->history.unknown_reason = UnknownReason::kLostOperations;
     store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
-    store.Set(as, std::move(*fresh), txn);
+    store.Set(as, std::move(fresh->history), txn);
   }
   // Any serialized bytes may have been overwritten.
   store.InvalidateAllBlobs(txn);
@@ -360,7 +440,6 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
 
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
              SubmissionCaptures* captures) {
-  store.ops_applied.fetch_add(1, std::memory_order_relaxed);
   switch (op.kind) {
     case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
     case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;

@@ -13,7 +13,8 @@ namespace asval {
 // structure, its buffer or the binding is unknown.
 std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as);
 
-// Applies one operation of `batch` to the histories in `state.history.store`. txn (may be null) collects the
+// Applies one operation of `batch` to the histories in `state.history.store` (the caller counts it in
+// store.ops_applied, once per batch: one atomic add, not one per operation). txn (may be null) collects the
 // changes so that a skipped or failed submission can be rolled back. captures (may be null: host operations,
 // which capture nothing) collects what the submission's captured builds ask for once it completes: their
 // activity, and the updates to compare with their sources'.

@@ -96,6 +96,7 @@ void AttachBlobCapture(CommandBufferState& recording, uint32_t captured, AsOp& o
 void ApplyNow(DeviceState& state, const OpBatch& batch) {
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
   for (const AsOp& op : batch.ops()) ApplyOp(state, state.history.store, batch, op, nullptr);
+  state.history.store.ops_applied.fetch_add(batch.ops().size(), std::memory_order_relaxed);
 }
 
 }  // namespace

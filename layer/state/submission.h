@@ -32,9 +32,7 @@ class HistorySubmission {
   explicit HistorySubmission(DeviceState& state) : state_(state) {}
   HistorySubmission(const HistorySubmission&) = delete;
   HistorySubmission& operator=(const HistorySubmission&) = delete;
-  ~HistorySubmission() {
-    if (store_lock_.owns_lock()) store_lock_.unlock();
-  }
+  ~HistorySubmission();
 
   // Applies the operations of one submitted command buffer, in recording order, calling
   // check(const HistoryStore&, const OpBatch&, const AsOp&) before each.
@@ -44,18 +42,20 @@ class HistorySubmission {
     std::shared_ptr<const RecordedOps> ops;
     if (!Lookup(cb, &ops)) return;  // most submitted command buffers build nothing: no lock
     Begin();
+    HistoryStore& store = state_.history.store;
     if (!ops || ops->lost) {
       // A command buffer the layer never saw allocated, or whose operations it could not record.
-      ApplyUnknownCommandBuffer(state_, state_.history.store, &txn_);
+      ApplyUnknownCommandBuffer(state_, store, txn_.get());
       return;
     }
     const OpBatch& batch = ops->batch;
-    txn_.ReserveMore(batch.ops().size() * 2);  // one entry per written structure, and some clobbers
+    txn_->ReserveMore(batch.ops().size());  // one entry per written structure (clobbers are rare)
     for (const AsOp& op : batch.ops()) {
-      check(static_cast<const HistoryStore&>(state_.history.store), batch, op);
-      ApplyOp(state_, state_.history.store, batch, op, &txn_, &captures_);
-      ++ops_applied_;
+      check(static_cast<const HistoryStore&>(store), batch, op);
+      ApplyOp(state_, store, batch, op, txn_.get(), &captures_);
     }
+    ops_applied_ += batch.ops().size();
+    store.ops_applied.fetch_add(batch.ops().size(), std::memory_order_relaxed);
   }
   // Releases the store's lock (the order lock stays held until destruction).
   void EndApply() {
@@ -77,7 +77,8 @@ class HistorySubmission {
   // Declared before store_lock_: released after it.
   std::unique_lock<std::recursive_mutex> order_lock_;
   std::unique_lock<std::mutex> store_lock_;
-  Transaction txn_;
+  // From the store's spares when the first command buffer with operations is applied (null before).
+  std::unique_ptr<Transaction> txn_;
   SubmissionCaptures captures_;
   uint64_t ops_applied_ = 0;
 };

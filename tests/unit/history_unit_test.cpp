@@ -636,62 +636,85 @@ TEST_CASE("copies unit: host property queries and copies with valid arguments st
   CHECK(reporter.ErrorCount() == 2);
 }
 
-// Not run by default ([.]): the submission-time cost behind docs/performance.md. Run it alone, optionally
-// under callgrind with --toggle-collect='*HistorySubmission*' to count only the layer's submission work:
+// Not run by default ([.]): the submission-time cost behind docs/performance.md ("Submit path (issue 13,
+// deliverable 5)"). One test case per scenario, so that each can be measured alone; the timed submissions run in
+// HistoryBenchSubmissions, so that callgrind counts them without the set-up (the first builds, the recording):
 //   asval_unit_tests "[.history-bench]"
-TEST_CASE("history bench: operations applied per second at submission", "[.history-bench]") {
-  struct Scenario {
-    const char* name;
-    uint32_t structures;  // one operation per structure per submission
-    bool update;          // steady-state frames update; start-up builds
-    uint32_t submissions;
-  };
-  for (const Scenario& sc : {Scenario{"per-frame updates of 64 BLASes", 64, true, 2000},
-                             Scenario{"start-up batch of 2000 builds", 2000, false, 50},
-                             Scenario{"command buffer without AS operations", 0, true, 100000}}) {
-    World w;
-    std::vector<VkAccelerationStructureKHR> handles;
-    for (uint32_t i = 0; i < sc.structures; ++i) {
-      handles.push_back(Fake<VkAccelerationStructureKHR>(1000 + i));
-      w.Structure(handles.back(), Fake<VkBuffer>(5000 + i), (VkDeviceSize{1} << 16) * (i + 32));
-    }
-    Reporter reporter(ReportSettings{});
-    const VkCommandPool pool = Fake<VkCommandPool>(3);
-    const VkCommandBuffer cb = Fake<VkCommandBuffer>(100);
-    AllocateCommandBuffers(w.state, pool, 1, &cb);
+//   valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*HistoryBenchSubmissions*'
+//       asval_unit_tests "history bench: per-frame updates of 64 BLASes"    (one command line)
+struct BenchScenario {
+  const char* name;
+  uint32_t structures;  // one operation per structure per submission
+  bool update;          // steady-state frames update; start-up builds
+  uint32_t submissions;
+  // Structures placed this many bytes apart (64 KiB each): less than 64 KiB makes neighbours overlap, so that
+  // every operation clobbers one.
+  VkDeviceSize stride = VkDeviceSize{1} << 16;
+};
+
+// The timed part: `submissions` submissions of cb. Returns the operations applied.
+[[gnu::noinline]] uint64_t HistoryBenchSubmissions(World& w, Reporter& reporter, VkCommandBuffer cb,
+                                                   uint32_t submissions) {
+  uint64_t ops = 0;
+  for (uint32_t s = 0; s < submissions; ++s) {
+    const Submitted submitted = SubmitCommandBuffers(w, reporter, {cb});
+    REQUIRE_FALSE(submitted.reported);
+    ops += submitted.ops;
+  }
+  return ops;
+}
+
+void RunHistoryBench(const BenchScenario& sc) {
+  World w;
+  std::vector<VkAccelerationStructureKHR> handles;
+  for (uint32_t i = 0; i < sc.structures; ++i) {
+    handles.push_back(Fake<VkAccelerationStructureKHR>(1000 + i));
+    w.Structure(handles.back(), Fake<VkBuffer>(5000 + i), sc.stride * (i + 32));
+  }
+  Reporter reporter(ReportSettings{});
+  const VkCommandPool pool = Fake<VkCommandPool>(3);
+  const VkCommandBuffer cb = Fake<VkCommandBuffer>(100);
+  AllocateCommandBuffers(w.state, pool, 1, &cb);
+  w.state.command_buffers.Reset(cb);
+  std::vector<Build> builds;
+  builds.reserve(sc.structures * 2);
+  for (VkAccelerationStructureKHR as : handles) builds.emplace_back(as, std::vector<uint32_t>{4, 4}, kUpdatable);
+  for (const Build& b : builds) {  // the first build of each, so that updates have a source
+    RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &b.info, &b.range_pointer);
+  }
+  w.state.command_buffers.End(cb);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {cb}).reported);
+  if (sc.update) {
     w.state.command_buffers.Reset(cb);
-    std::vector<Build> builds;
-    builds.reserve(sc.structures * 2);
-    for (VkAccelerationStructureKHR as : handles) builds.emplace_back(as, std::vector<uint32_t>{4, 4}, kUpdatable);
-    for (const Build& b : builds) {  // the first build of each, so that updates have a source
-      RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &b.info, &b.range_pointer);
+    const size_t count = builds.size();
+    for (size_t i = 0; i < count; ++i) {
+      builds.emplace_back(handles[i], std::vector<uint32_t>{4, 4}, kUpdatable, handles[i]);
+    }
+    for (size_t i = count; i < builds.size(); ++i) {
+      RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &builds[i].info, &builds[i].range_pointer);
     }
     w.state.command_buffers.End(cb);
-    REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {cb}).reported);
-    if (sc.update) {
-      w.state.command_buffers.Reset(cb);
-      const size_t count = builds.size();
-      for (size_t i = 0; i < count; ++i) {
-        builds.emplace_back(handles[i], std::vector<uint32_t>{4, 4}, kUpdatable, handles[i]);
-      }
-      for (size_t i = count; i < builds.size(); ++i) {
-        RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &builds[i].info, &builds[i].range_pointer);
-      }
-      w.state.command_buffers.End(cb);
-    }
-    const auto start = std::chrono::steady_clock::now();
-    uint64_t ops = 0;
-    for (uint32_t s = 0; s < sc.submissions; ++s) {
-      const Submitted submitted = SubmitCommandBuffers(w, reporter, {cb});
-      REQUIRE_FALSE(submitted.reported);
-      ops += submitted.ops;
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s: %u submissions, %llu operations, %.0f ns per submission, %.2f M operations/s\n", sc.name,
-                sc.submissions, static_cast<unsigned long long>(ops), seconds * 1e9 / sc.submissions,
-                ops ? ops / seconds / 1e6 : 0.0);
-    CHECK(reporter.ErrorCount() == 0);
   }
+  const auto start = std::chrono::steady_clock::now();
+  const uint64_t ops = HistoryBenchSubmissions(w, reporter, cb, sc.submissions);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s: %u submissions, %llu operations, %.0f ns per submission, %.2f M operations/s\n", sc.name,
+              sc.submissions, static_cast<unsigned long long>(ops), seconds * 1e9 / sc.submissions,
+              ops ? ops / seconds / 1e6 : 0.0);
+  CHECK(ops == uint64_t{sc.structures} * sc.submissions);
+  CHECK(reporter.ErrorCount() == 0);
+}
+
+TEST_CASE("history bench: per-frame updates of 64 BLASes", "[.history-bench]") {
+  RunHistoryBench(BenchScenario{"per-frame updates of 64 BLASes", 64, true, 2000});
+}
+
+TEST_CASE("history bench: start-up batch of 2000 builds", "[.history-bench]") {
+  RunHistoryBench(BenchScenario{"start-up batch of 2000 builds", 2000, false, 50});
+}
+
+TEST_CASE("history bench: command buffer without AS operations", "[.history-bench]") {
+  RunHistoryBench(BenchScenario{"command buffer without AS operations", 0, true, 100000});
 }
 
 }  // namespace
