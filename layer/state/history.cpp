@@ -108,37 +108,19 @@ void HistoryStore::SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHisto
   if (moved) Index(record, as);
 }
 
-AsHistory& HistoryStore::Rewrite(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
-                                  const std::shared_ptr<const BuildSnapshot>& build) {
+AsHistory& HistoryStore::RewriteInPlace(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
+                                         const std::shared_ptr<const BuildSnapshot>& build) {
   Record& r = records_[record];
   const uint64_t version = ++version_counter_;
-  AsHistory* h = &r.history();
-  if (txn && txn->id_ != 0 && r.flipped_by != txn->id_) {
-    // The other slot holds what undo no longer needs (a transaction over, or one that never flipped this record).
-    AsHistory& next = r.slots[r.current ^ 1];
-    next.span = h->span;
-    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kFlip, static_cast<uint32_t>(txn->flips_.size())});
-    txn->flips_.push_back(Transaction::FlipChange{as, version, r.version});
-    r.current ^= 1;
-    r.flipped_by = txn->id_;
-    h = &next;
-  } else if (txn) {
+  AsHistory& h = r.history();
+  if (txn) {
     txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
                                                static_cast<uint32_t>(txn->histories_.size())});
-    txn->histories_.emplace_back(as, version, r.version, true, std::move(*h));  // leaves the span as it was
+    txn->histories_.emplace_back(as, version, r.version, true, std::move(h));  // leaves the span as it was
   }
   r.version = version;
-  h->kind = HistoryKind::kNeverBuilt;
-  h->unknown_reason = UnknownReason::kNone;
-  // A structure rebuilt or updated every frame finds the snapshot it had two writes ago in the slot: no reference
-  // count changes.
-  if (h->build != build) h->build = build;
-  h->clobbered.reset();
-  h->generation = NextGeneration();
-  h->serialization_size = 0;
-  h->serialization_size_generation = 0;
-  h->activity.reset();
-  return *h;
+  ResetForRewrite(h, build);
+  return h;
 }
 
 std::unique_ptr<Transaction> HistoryStore::TakeTransaction() {
@@ -294,7 +276,7 @@ void HistoryStore::Undo(Transaction& txn) {
         break;
       }
       case Transaction::Kind::kFlip: {
-        const Transaction::FlipChange& flip = txn.flips_[e->at];
+        const Transaction::Entry& flip = *e;
         const uint32_t record = RecordOf(flip.as);
         if (record == kNoRecord || records_[record].version != flip.version) break;  // changed since: keep it
         Record& r = records_[record];

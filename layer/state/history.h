@@ -115,13 +115,11 @@ class Transaction {
   bool empty() const { return entries_.empty(); }
   void ReserveMore(std::size_t entries) {
     entries_.reserve(entries_.size() + entries);
-    flips_.reserve(flips_.size() + entries);
   }
   // Forgets every entry (the changes stay), keeping the capacity.
   void Clear() {
     entries_.clear();
     histories_.clear();
-    flips_.clear();
     blobs_.clear();
     slots_.clear();
   }
@@ -129,10 +127,14 @@ class Transaction {
  private:
   friend class HistoryStore;
   enum class Kind : uint8_t { kHistory, kFlip, kBlobAdded, kBlobInvalidated, kSlot };
-  // In the order the changes were made; `at` indexes the array of its kind.
+  // In the order the changes were made; `at` indexes the array of its kind. A record rewritten into its other
+  // history slot (kFlip, HistoryStore::Rewrite) is undone by switching back: the entry holds all there is to it.
   struct Entry {
     Kind kind;
-    uint32_t at;
+    uint32_t at = 0;
+    VkAccelerationStructureKHR as = VK_NULL_HANDLE;  // kFlip
+    uint64_t version = 0;                            // kFlip: the version the rewrite wrote
+    uint64_t old_version = 0;                        // ... and the one it replaced
   };
   struct HistoryChange {
     HistoryChange(VkAccelerationStructureKHR as_, uint64_t version_, uint64_t old_version_, bool existed_,
@@ -144,12 +146,6 @@ class Transaction {
     bool existed;          // false: the record did not exist (undone by forgetting it)
     AsHistory old_history;
   };
-  // A record rewritten into its other history slot (HistoryStore::Rewrite): undone by switching back.
-  struct FlipChange {
-    VkAccelerationStructureKHR as;
-    uint64_t version;
-    uint64_t old_version;
-  };
   struct SlotChange {
     std::pair<VkQueryPool, uint32_t> key;
     uint64_t version;
@@ -160,7 +156,6 @@ class Transaction {
   uint64_t id_ = 0;
   std::vector<Entry> entries_;
   std::vector<HistoryChange> histories_;
-  std::vector<FlipChange> flips_;
   std::vector<uint64_t> blobs_;  // kBlobAdded / kBlobInvalidated: the blob's id
   std::vector<SlotChange> slots_;
 };
@@ -198,7 +193,20 @@ class HistoryStore {
   // where it was (undo switches back: nothing is moved or copied into the log); later ones in the same
   // transaction, and those without one, move the old history into the log (or drop it).
   AsHistory& Rewrite(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
-                     const std::shared_ptr<const BuildSnapshot>& build);
+                     const std::shared_ptr<const BuildSnapshot>& build) {
+    Record& r = records_[record];
+    if (!txn || txn->id_ == 0 || r.flipped_by == txn->id_) return RewriteInPlace(record, as, txn, build);
+    // The other slot holds what undo no longer needs (a transaction over, or one that never flipped this record).
+    const uint64_t version = ++version_counter_;
+    AsHistory& h = r.slots[r.current ^ 1];
+    h.span = r.slots[r.current].span;
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kFlip, 0, as, version, r.version});
+    r.current ^= 1;
+    r.flipped_by = txn->id_;
+    r.version = version;
+    ResetForRewrite(h, build);
+    return h;
+  }
 
   // A submission's undo log: a spare one (keeping the capacity an earlier submission gave it) or a new one; and
   // back when the submission is over (cleared by the caller, outside the lock: the old histories it releases
@@ -297,6 +305,20 @@ class HistoryStore {
   void Index(uint32_t record, VkAccelerationStructureKHR as);
   uint32_t Insert(VkAccelerationStructureKHR as, AsHistory history, uint64_t version);
   void Push(Transaction* txn, Transaction::Kind kind, uint64_t blob_id);
+  AsHistory& RewriteInPlace(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
+                            const std::shared_ptr<const BuildSnapshot>& build);
+  void ResetForRewrite(AsHistory& h, const std::shared_ptr<const BuildSnapshot>& build) {
+    h.kind = HistoryKind::kNeverBuilt;
+    h.unknown_reason = UnknownReason::kNone;
+    // A structure rebuilt or updated every frame finds the snapshot it had two writes ago in the slot: no
+    // reference count changes.
+    if (h.build != build) h.build = build;
+    h.clobbered.reset();
+    h.generation = NextGeneration();
+    h.serialization_size = 0;
+    h.serialization_size_generation = 0;
+    h.activity.reset();
+  }
 
   mutable std::mutex mutex_;
   // Records by index (stable while the structure has one), found through index_; freed indices are reused.

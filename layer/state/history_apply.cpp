@@ -210,6 +210,25 @@ std::shared_ptr<BuildActivity> HostActivity(const AsOp& op) {
   return node;
 }
 
+// The record whose snapshot a build or update of dst may share: dst's own (a build), or the source's (an update; most
+// are in place: the source's record is the destination's, already found). kNoRecord when it has none.
+uint32_t BaseRecord(const HistoryStore& store, const AsOp& op, uint32_t dst_record) {
+  return !op.is_update() || op.src == op.dst ? dst_record : store.RecordOf(op.src);
+}
+
+// What this operation left last time its batch was applied, when it is still there to share: its own parameters
+// (made from them, or compared equal), so finding it again in the source (update) or in dst (build) is finding
+// the same parameters. Null when it must compare.
+[[gnu::always_inline]] inline const std::shared_ptr<const BuildSnapshot>* RememberedSnapshot(
+    const HistoryStore& store, const OpBatch& batch, const AsOp& op, uint32_t dst_record) {
+  std::shared_ptr<const BuildSnapshot>* memo = batch.AppliedSnapshot(op);
+  if (!memo || !*memo) return nullptr;
+  const uint32_t base_record = BaseRecord(store, op, dst_record);
+  if (base_record == HistoryStore::kNoRecord) return nullptr;
+  const AsHistory& base = store.HistoryAt(base_record);
+  return base.build == *memo && (!op.is_update() || base.kind == HistoryKind::kBuilt) ? memo : nullptr;
+}
+
 // The parameters a build or update leaves in dst (dst_record: dst's record, kNoRecord when it has none): shared
 // with the source's or the previous build's when they are the same, so that steady frames allocate nothing.
 // Returned by reference, so that finding the same snapshot again copies no shared pointer: to the batch's memo of
@@ -217,15 +236,12 @@ std::shared_ptr<BuildActivity> HostActivity(const AsOp& op) {
 const std::shared_ptr<const BuildSnapshot>& BuiltSnapshot(const HistoryStore& store, const OpBatch& batch,
                                                           const AsOp& op, uint32_t dst_record,
                                                           std::shared_ptr<const BuildSnapshot>& storage) {
-  // Most updates are in place: the source's record is the destination's, already found.
-  const uint32_t base_record = !op.is_update() ? dst_record : op.src == op.dst ? dst_record : store.RecordOf(op.src);
-  const AsHistory* base = base_record != HistoryStore::kNoRecord ? &store.HistoryAt(base_record) : nullptr;
-  // What this operation left last time it was applied: its own parameters (made from them, or compared equal), so
-  // finding it again in the source (update) or in dst (build) is finding the same parameters.
-  std::shared_ptr<const BuildSnapshot>* memo = batch.AppliedSnapshot(op);
-  if (memo && *memo && base && base->build == *memo && (!op.is_update() || base->kind == HistoryKind::kBuilt)) {
-    return *memo;
+  if (const std::shared_ptr<const BuildSnapshot>* remembered = RememberedSnapshot(store, batch, op, dst_record)) {
+    return *remembered;
   }
+  const uint32_t base_record = BaseRecord(store, op, dst_record);
+  const AsHistory* base = base_record != HistoryStore::kNoRecord ? &store.HistoryAt(base_record) : nullptr;
+  std::shared_ptr<const BuildSnapshot>* memo = batch.AppliedSnapshot(op);
   std::shared_ptr<const BuildSnapshot>& built = memo ? *memo : storage;
   if (op.is_update()) {
     built = base ? UpdateSnapshot(*base, batch, op) : MakeSnapshot(batch, op);
@@ -252,7 +268,9 @@ void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& ba
       store.HistoryAt(record).span.memory != VK_NULL_HANDLE) {
     // The common case, a structure built before: its record is rewritten in place, its span known and unchanged.
     std::shared_ptr<const BuildSnapshot> storage;
-    const std::shared_ptr<const BuildSnapshot>& build = BuiltSnapshot(store, batch, op, record, storage);
+    const std::shared_ptr<const BuildSnapshot>* remembered = RememberedSnapshot(store, batch, op, record);
+    const std::shared_ptr<const BuildSnapshot>& build =
+        remembered ? *remembered : BuiltSnapshot(store, batch, op, record, storage);
     std::shared_ptr<BuildActivity> activity = BuiltActivity(state, store, op, captures);
     AsHistory& h = store.Rewrite(record, op.dst, txn, build);
     h.kind = HistoryKind::kBuilt;

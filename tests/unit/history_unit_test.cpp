@@ -12,6 +12,7 @@
 
 #include "build_command.h"
 #include "copies.h"
+#include "handle_index.h"
 #include "history_apply.h"
 #include "history_host.h"
 #include "history_test_builds.h"
@@ -606,6 +607,136 @@ TEST_CASE("history unit: serialization sizes read back attach to the contents th
   OpBatch enough;
   enough.Append(op);
   CHECK(Execute(w, enough).empty());
+}
+
+// A recorded and ended command buffer of builds (the bench's and the submit path's tests' way).
+VkCommandBuffer RecordedBuilds(World& w, uintptr_t handle, std::initializer_list<const Build*> builds) {
+  const VkCommandBuffer cb = Fake<VkCommandBuffer>(handle);
+  AllocateCommandBuffers(w.state, Fake<VkCommandPool>(3), 1, &cb);
+  w.state.command_buffers.Reset(cb);
+  for (const Build* b : builds) RecordCmdBuild(w.state, cb, OpCommand::kCmdBuild, 1, &b->info, &b->range_pointer);
+  w.state.command_buffers.End(cb);
+  return cb;
+}
+
+size_t GeometriesOf(World& w, VkAccelerationStructureKHR as) {
+  auto lock = w.state.history.store.Lock();
+  const AsHistory* h = w.state.history.store.Find(as);
+  return h && h->build ? h->build->geometries.size() : 0;
+}
+
+// A submission's first write of a record goes to the record's other slot and its undo switches back; a second write
+// of the same record in that submission moves the old history into the log instead. Either way a rejected
+// submission leaves every record as it found it, generation included.
+TEST_CASE("history unit: a rejected submission that rewrote a structure twice is undone exactly", "[history]") {
+  World w;
+  Reporter reporter(ReportSettings{});
+  const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), three(w.a, {1, 1, 1}, kUpdatable);
+  const Build b(w.b, {1}, kUpdatable);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 101, {&one})}).reported);
+  uint64_t generation = 0;
+  {
+    auto lock = w.state.history.store.Lock();
+    generation = w.state.history.store.Get(w.a).generation;
+  }
+  const VkCommandBuffer twice = RecordedBuilds(w, 102, {&two, &b, &three});
+  for (int round = 0; round < 3; ++round) {  // the slots swap roles with every accepted submission in between
+    SubmitCommandBuffers(w, reporter, {twice}, VK_ERROR_DEVICE_LOST);
+    CHECK(GeometriesOf(w, w.a) == 1);
+    {
+      auto lock = w.state.history.store.Lock();
+      CHECK(w.state.history.store.Get(w.a).generation == generation);
+      CHECK(w.state.history.store.Find(w.b) == nullptr);  // never built: its record is gone again
+    }
+    REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 103, {&two})}).reported);
+    CHECK(GeometriesOf(w, w.a) == 2);
+    REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 104, {&one})}).reported);
+    auto lock = w.state.history.store.Lock();
+    generation = w.state.history.store.Get(w.a).generation;
+  }
+  CHECK(reporter.ErrorCount() == 0);
+}
+
+// A host build completing while a submission's downcall runs changes the record the submission flipped: the
+// submission's undo leaves the newer history alone.
+TEST_CASE("history unit: undo of a flipped record keeps a host build that completed since", "[history]") {
+  World w;
+  HistoryStore& store = w.state.history.store;
+  const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), three(w.a, {1, 1, 1}, kUpdatable);
+  CHECK(Execute(w, Builds(OpCommand::kCmdBuild, {&one})).empty());
+  const OpBatch ours = Builds(OpCommand::kCmdBuild, {&two});
+  const OpBatch host = Builds(OpCommand::kHostBuild, {&three});
+  auto lock = store.Lock();
+  std::unique_ptr<Transaction> txn = store.TakeTransaction();
+  ApplyOp(w.state, store, ours, ours.ops()[0], txn.get());
+  CHECK(store.Get(w.a).build->geometries.size() == 2);
+  ApplyOp(w.state, store, host, host.ops()[0], nullptr);
+  store.Undo(*txn);
+  CHECK(store.Get(w.a).build->geometries.size() == 3);
+  store.ReturnTransaction(std::move(txn));
+}
+
+// The aliasing query is skipped for a structure nothing overlapped when it was last searched; a structure that
+// comes to overlap it later must still be clobbered by its next write.
+TEST_CASE("history unit: a structure created over one that owned its bytes is clobbered by that one's rebuild",
+          "[history]") {
+  World w;
+  const Build a(w.a, {1}, kUpdatable), alias(w.alias_of_a, {1}, kUpdatable);
+  const Build update_a(w.a, {1}, kUpdatable, w.a), update_alias(w.alias_of_a, {1}, kUpdatable, w.alias_of_a);
+  Reporter reporter(ReportSettings{});
+  // Through submissions, so that the batches remember their snapshots as the layer's do.
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 111, {&a, &update_a})}).reported);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 112, {&alias})}).reported);  // clobbers a
+  CHECK(reporter.WarningCount() == 0);
+  // ASVAL-History-Clobbered: a was written over by alias. The update writes a's bytes, which alias shares since
+  // a was last searched: alias is clobbered in turn.
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 113, {&update_a})}).reported);
+  CHECK(reporter.WarningCount() == 1);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 114, {&update_alias})}).reported);
+  CHECK(reporter.WarningCount() == 2);
+  CHECK(reporter.ErrorCount() == 0);
+}
+
+// A submitted batch remembers the snapshot each build left; a rebuild with other parameters in between must not
+// let an update resubmitted after it share the remembered one.
+TEST_CASE("history unit: a resubmitted update follows a rebuild with other parameters in between", "[history]") {
+  World w;
+  Reporter reporter(ReportSettings{});
+  const Build one(w.a, {1}, kUpdatable), two(w.a, {1, 1}, kUpdatable), update(w.a, {1}, kUpdatable, w.a);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 121, {&one})}).reported);
+  const VkCommandBuffer frame = RecordedBuilds(w, 122, {&update});
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {frame}).reported);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {frame}).reported);
+  CHECK(reporter.ErrorCount() == 0);
+  const VkCommandBuffer rebuild_two = RecordedBuilds(w, 123, {&two});
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {rebuild_two}).reported);
+  SubmitCommandBuffers(w, reporter, {frame});  // geometryCount 1 against 2: 03758
+  CHECK(reporter.ErrorCount() == 1);
+  CHECK(GeometriesOf(w, w.a) == 1);  // the update that does not repeat its source leaves its own parameters
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {rebuild_two}).reported);
+  CHECK(GeometriesOf(w, w.a) == 2);
+  REQUIRE_FALSE(SubmitCommandBuffers(w, reporter, {RecordedBuilds(w, 124, {&one})}).reported);
+  SubmitCommandBuffers(w, reporter, {frame});
+  CHECK(reporter.ErrorCount() == 1);
+  CHECK(GeometriesOf(w, w.a) == 1);
+}
+
+TEST_CASE("history unit: the store's handle index finds, erases and refills keys across growth", "[history]") {
+  HandleIndex index;
+  // Keys spaced like handles (16-byte aligned pointers), enough to grow the table several times.
+  const auto key = [](uint64_t i) { return 0x7f0000001000ULL + i * 16; };
+  for (uint32_t i = 0; i < 1000; ++i) index.Insert(key(i), i);
+  CHECK(index.size() == 1000);
+  for (uint32_t i = 0; i < 1000; i += 3) CHECK(index.Erase(key(i)));
+  CHECK_FALSE(index.Erase(key(0)));
+  for (uint32_t i = 0; i < 1000; ++i) {
+    CHECK(index.Find(key(i)) == (i % 3 == 0 ? HandleIndex::kNone : i));
+  }
+  for (uint32_t i = 0; i < 1000; i += 3) index.Insert(key(i), i + 5000);
+  for (uint32_t i = 0; i < 1000; ++i) CHECK(index.Find(key(i)) == (i % 3 == 0 ? i + 5000 : i));
+  CHECK(index.Find(0) == HandleIndex::kNone);
+  CHECK(index.Find(key(1000)) == HandleIndex::kNone);
+  CHECK(index.size() == 1000);
 }
 
 TEST_CASE("copies unit: host property queries and copies with valid arguments stay silent", "[copies]") {
