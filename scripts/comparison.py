@@ -295,6 +295,56 @@ def plot(points, path, title):
     fig.savefig(path, dpi=110)
 
 
+def keep_beside(path, docs, name):
+    """Copies a run's JSON next to the document (without the runs' output tails) and returns it loaded."""
+    with open(path) as f:
+        data = json.load(f)
+    for c in data.get("cases", []):
+        for r in c["results"].values():
+            r.pop("output", None)
+    target = os.path.join(docs, name)
+    with open(target, "w") as f:
+        json.dump(data, f, indent=1)
+    return data
+
+
+def gpu_section(args, docs):
+    out = ["## On a real GPU: %s" % args.gpu_name, "",
+           "Measured with `scripts/device_comparison.sh overhead` and `scripts/device_comparison.sh corpus` on the "
+           "device machine (16 cores, Ubuntu 24.04, Debian's Vulkan loader 1.3.239). That image has no Khronos "
+           "layer: Debian's 1.3.239 was carried along. It runs only the corpus's valid programs there, since an "
+           "invalid build that it does not catch reaches the GPU, and some hang it. No callgrind on that image: wall "
+           "times only.", ""]
+    if args.gpu_overhead_json:
+        overhead = keep_beside(args.gpu_overhead_json, docs, "comparison-h200-overhead.json")
+        out += ["### Overhead", "", "Raw: [comparison-h200-overhead.json](comparison-h200-overhead.json).", "",
+                overhead_table(overhead), ""]
+    if args.gpu_corpus_json:
+        corpus = keep_beside(args.gpu_corpus_json, docs, "comparison-h200-corpus.json")
+        cases = corpus["cases"]
+        a = corpus_counts(cases, "asval")
+        k = corpus_counts(cases, "khronos")
+        out += ["### Corpus", "", "Raw: [comparison-h200-corpus.json](comparison-h200-corpus.json).", "",
+                "asval reports %d of %d labelled VUIDs, with %d false positives on %d valid programs; the Khronos layer "
+                "reports errors on %d of the %d valid programs." % (a[0], a[1], a[2], a[3], k[2], k[3]), "",
+                "The labels are exact on lavapipe. Where this driver's sizes or alignments differ (its scratch "
+                "alignment is 128, lavapipe's 8; its structures are larger), a case can break one more rule there, "
+                "which asval rightly reports. Every difference from the labels:", ""]
+        diffs = []
+        for c in cases:
+            r = c["results"].get("asval")
+            if not r:
+                continue
+            if r["missed"] or r["extra"] or r["status"] != "done" or (not c["expected"] and r["warnings"]):
+                diffs.append("- `%s`: labelled %s; reported %s%s" % (
+                    c["name"], ", ".join(v.replace("VUID-", "") for v in c["expected"]) or "nothing",
+                    ", ".join(v.replace("VUID-", "") for v in r["errors"]) or "nothing",
+                    "" if r["status"] == "done" else "; the run ended: " + r["status"]))
+        out += diffs or ["(none)"]
+        out.append("")
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -302,6 +352,10 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--corpus-json")
     ap.add_argument("--overhead-json")
+    ap.add_argument("--gpu-corpus-json", help="the corpus run on a GPU (scripts/device_comparison.sh corpus)")
+    ap.add_argument("--gpu-overhead-json", help="the overhead run on a GPU (scripts/device_comparison.sh overhead)")
+    ap.add_argument("--gpu-name", default="NVIDIA H200, driver 580.159.04",
+                    help="the GPU and driver those runs used (they are stored beside the document)")
     args = ap.parse_args()
     ensure_matplotlib()
     build = os.path.abspath(args.build)
@@ -409,6 +463,8 @@ def main():
             diffs.append("- `%s` (valid): reports %s" % (c["name"], ", ".join(r["errors"])))
     doc += diffs or ["(none)"]
     doc.append("")
+    if args.gpu_corpus_json or args.gpu_overhead_json:
+        doc += gpu_section(args, docs)
     with open(args.out, "w") as f:
         f.write("\n".join(doc))
     print("wrote %s and %s" % (args.out, png))
