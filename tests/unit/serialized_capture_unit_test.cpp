@@ -146,7 +146,8 @@ TEST_CASE("serialization unit: a deserialization restores only when its bytes ma
   // A serialization whose bytes could not be read leaves its content unknown: nothing matches it.
   auto unknown = std::make_shared<SerializedContent>();
   SubmissionCaptures cut;
-  cut.serializes.push_back(SerializeCapture{BlobLog(512, 256).log, 0, unknown, false});
+  const BlobLog short_read(512, 256);  // named: the log points into its bytes, which must outlive the completion
+  cut.serializes.push_back(SerializeCapture{short_read.log, 0, unknown, false});
   CompleteSerializedCaptures(store, counters, cut);
   CHECK(unknown->status == SerializedContent::Status::kUnknown);
 }
