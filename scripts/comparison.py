@@ -121,7 +121,17 @@ def run_overhead(build, out, rounds):
         merged = json.load(f)
     with open(out + ".view") as f:
         extra = json.load(f)
-    # The family rows are taken relative to their own run's none: stored as that ratio applied to the main run's.
+    merge_family_rows(merged, extra)
+    merged["command_view"] = extra.get("command")
+    with open(out, "w") as f:
+        json.dump(merged, f, indent=1)
+    os.remove(out + ".view")
+    return "%s; %s" % (" ".join(main[1:]), " ".join(view[1:]))
+
+
+def merge_family_rows(merged, extra):
+    """Adds the family-off rows of a second run to `merged`, each taken relative to its own run's none and stored
+    as that ratio (wall) or difference (instructions) applied to the main run's none."""
     look = {(r["row"], r["config"]): r for r in extra["rows"]}
     main_none = {r["row"]: r for r in merged["rows"] if r["config"] == "none"}
     for r in extra["rows"]:
@@ -137,11 +147,6 @@ def run_overhead(build, out, rounds):
             r["ir_per_call"] = r["ir_per_call"] - base["ir_per_call"] + ref["ir_per_call"]
         r["rescaled_to_main_none"] = True
         merged["rows"].append(r)
-    merged["command_view"] = extra.get("command")
-    with open(out, "w") as f:
-        json.dump(merged, f, indent=1)
-    os.remove(out + ".view")
-    return "%s; %s" % (" ".join(main[1:]), " ".join(view[1:]))
 
 
 def md_table(header, rows):
@@ -243,8 +248,12 @@ def added_ir(look, row, config):
     return r["ir_per_call"] - base["ir_per_call"]
 
 
-def view_points(cases, overhead):
+def view_points(cases, overhead, frame_overhead):
+    """Per configuration: corpus faults missed (this machine's corpus run), instructions added (callgrind, this
+    machine) and the dynamic frame's added time (frame_overhead: the GPU's run when there is one, since frame times
+    on a loaded CPU driver are noise)."""
     look = overhead_lookup(overhead)
+    frames = overhead_lookup(frame_overhead)
     configs = ["asval"] + list(CAPTURE_CONFIGS) + list(FAMILY_CONFIGS) + ["khronos"]
     points = []
     for config in configs:
@@ -254,7 +263,7 @@ def view_points(cases, overhead):
         missed = sorted({c["name"] for c in cases if c["expected"] and config in c["results"]
                          and c["results"][config]["missed"]})
         points.append({"config": config, "detected": detected, "expected": expected, "missed": missed,
-                       "scene": added_percent(look, "frame dynamic", config),
+                       "scene": added_percent(frames, "frame dynamic", config),
                        "build_ir": added_ir(look, "build 1x1", config),
                        "submit_ir": added_ir(look, "submit 1000 build+update", config)})
     return points
@@ -308,6 +317,18 @@ def keep_beside(path, docs, name):
     return data
 
 
+def load_gpu_overhead(args, docs):
+    """The GPU's overhead run, with its family-off frame rows merged in, kept beside the document."""
+    with open(args.gpu_overhead_json) as f:
+        overhead = json.load(f)
+    if args.gpu_overhead_families_json:
+        with open(args.gpu_overhead_families_json) as f:
+            merge_family_rows(overhead, json.load(f))
+    with open(os.path.join(docs, "comparison-h200-overhead.json"), "w") as f:
+        json.dump(overhead, f, indent=1)
+    return overhead
+
+
 def gpu_section(args, docs):
     out = ["## On a real GPU: %s" % args.gpu_name, "",
            "Measured with `scripts/device_comparison.sh overhead` and `scripts/device_comparison.sh corpus` on the "
@@ -316,7 +337,7 @@ def gpu_section(args, docs):
            "invalid build that it does not catch reaches the GPU, and some hang it. No callgrind on that image: wall "
            "times only.", ""]
     if args.gpu_overhead_json:
-        overhead = keep_beside(args.gpu_overhead_json, docs, "comparison-h200-overhead.json")
+        overhead = load_gpu_overhead(args, docs)
         out += ["### Overhead", "", "Raw: [comparison-h200-overhead.json](comparison-h200-overhead.json).", "",
                 overhead_table(overhead), ""]
     if args.gpu_corpus_json:
@@ -354,6 +375,8 @@ def main():
     ap.add_argument("--overhead-json")
     ap.add_argument("--gpu-corpus-json", help="the corpus run on a GPU (scripts/device_comparison.sh corpus)")
     ap.add_argument("--gpu-overhead-json", help="the overhead run on a GPU (scripts/device_comparison.sh overhead)")
+    ap.add_argument("--gpu-overhead-families-json",
+                    help="the GPU's dynamic frame with each family off (scripts/device_comparison.sh overhead)")
     ap.add_argument("--gpu-name", default="NVIDIA H200, driver 580.159.04",
                     help="the GPU and driver those runs used (they are stored beside the document)")
     args = ap.parse_args()
@@ -393,10 +416,13 @@ def main():
     vuids = registry()
     named = khronos_named(vuids)
     m = overhead.get("machine") or machine()
-    points = view_points(cases, overhead)
+    frame_overhead, frame_machine = overhead, m.get("driver", "this machine")
+    if args.gpu_overhead_json:
+        frame_overhead, frame_machine = load_gpu_overhead(args, docs), args.gpu_name
+    points = view_points(cases, overhead, frame_overhead)
     png = os.path.splitext(args.out)[0] + ".png"
-    title = "asval (each capture setting, each family off) and the Khronos layer %s on %s" % (
-        corpus.get("khronos_version") or "", m.get("driver", ""))
+    title = "asval (each capture setting, each family off) and the Khronos layer %s\nframe time on %s; misses in " \
+        "the corpus run on this machine's driver" % (corpus.get("khronos_version") or "", frame_machine)
     plot(points, png, title)
     a = corpus_counts(cases, "asval")
     k = corpus_counts(cases, "khronos")
@@ -442,7 +468,9 @@ def main():
            "## Run time against error",
            "",
            "What asval costs at each setting against what it then misses in the corpus; the Khronos layer as a "
-           "point of its own.",
+           "point of its own. Misses and instructions are this machine's (%s, callgrind); the dynamic frame's added "
+           "time is measured on %s (median of interleaved rounds), since frame times on a CPU driver sharing two "
+           "cores with other work are noise." % (m.get("driver"), frame_machine),
            "",
            "![run time against error](%s)" % os.path.basename(png),
            "",

@@ -24,7 +24,16 @@ nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 build=$PWD/.devrun/build
 case $what in
   overhead)
-    timeout 560 python3 bench/overhead/run_overhead.py --build "$build" --rounds 5 --json "$OUT/overhead-h200.json"
+    timeout 400 python3 bench/overhead/run_overhead.py --build "$build" --rounds 7 --json "$OUT/overhead-h200.json"
+    # The run time against error view: the dynamic frame with each family switched off (comparison.py's FAMILY_CONFIGS).
+    families=(features handles structure alignment addresses aliasing host copies history)
+    view=(); names=none
+    for f in "${families[@]}"; do
+      rest=$(printf '%s\n' "${families[@]}" | grep -vx "$f" | paste -sd, -)
+      view+=(--config "asval-no-$f:VK_ASVAL_AS_VALIDATION_ENABLED_CHECKS=$rest"); names+=",asval-no-$f"
+    done
+    timeout 150 python3 bench/overhead/run_overhead.py --build "$build" --rounds 9 --rows "frame dynamic" \
+      --configs "$names" "${view[@]}" --json "$OUT/overhead-h200-families.json"
     ;;
   corpus)
     timeout 560 python3 tests/corpus/run_corpus.py --corpus "$build/tests/corpus/asval_corpus" \
