@@ -406,6 +406,15 @@ def main():
     with open(overhead_json) as f:
         overhead = json.load(f)
     cases = corpus["cases"]
+    # Each run's command is kept in its JSON, so that a document regenerated from reused runs still names them.
+    if not args.corpus_json:
+        corpus["comparison_command"] = commands["corpus"]
+    if not args.overhead_json:
+        overhead["comparison_command"] = commands["overhead"]
+        with open(overhead_json, "w") as f:
+            json.dump(overhead, f, indent=1)
+    commands = {"corpus": corpus.get("comparison_command", commands["corpus"]),
+                "overhead": overhead.get("comparison_command", commands["overhead"])}
     # The corpus JSON is kept small: results only, not the runs' output tails.
     for c in cases:
         for r in c["results"].values():
@@ -432,9 +441,10 @@ def main():
            "the Khronos layer stacked alone with default settings (the installed package), asval alone with "
            "default settings unless a configuration says otherwise." % datetime.date.today().isoformat(),
            "",
-           "Machine: %s, %s cores; %s; %s; driver %s; Vulkan loader %s; Khronos validation layer %s; compiler %s; "
-           "asval %s." % (m.get("cpu"), m.get("cores"), m.get("os"), m.get("kernel", ""), m.get("driver"),
-                          m.get("loader"), m.get("khronos_layer"), m.get("compiler"), m.get("asval", machine()["asval"])),
+           "Machine: " + "; ".join(str(part) for part in [
+               "%s, %s cores" % (m.get("cpu"), m.get("cores")), m.get("os"), m.get("kernel"),
+               m.get("driver"), "Vulkan loader %s" % m.get("loader"), "Khronos validation layer %s" % m.get("khronos_layer"),
+               "compiler %s" % m.get("compiler"), "asval %s" % m.get("asval", machine()["asval"])] if part) + ".",
            "",
            "Commands: corpus `%s`; overhead `%s`." % (commands["corpus"], commands["overhead"]),
            "Raw results: [comparison-corpus.json](comparison-corpus.json), "
