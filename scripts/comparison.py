@@ -304,6 +304,14 @@ def plot(points, path, title):
     fig.savefig(path, dpi=110)
 
 
+def reuse(path, target):
+    """An earlier run's JSON, copied to where the document keeps it; returns what the document says of its command."""
+    if os.path.abspath(path) != target:
+        with open(path) as f, open(target, "w") as g:
+            g.write(f.read())
+    return "(reused: %s)" % path
+
+
 def keep_beside(path, docs, name):
     """Copies a run's JSON next to the document (without the runs' output tails) and returns it loaded."""
     with open(path) as f:
@@ -386,21 +394,11 @@ def main():
     os.makedirs(docs, exist_ok=True)
     corpus_json = os.path.join(docs, "comparison-corpus.json")
     overhead_json = os.path.join(docs, "comparison-overhead.json")
-    commands = {}
-    if args.corpus_json:
-        if os.path.abspath(args.corpus_json) != corpus_json:
-            with open(args.corpus_json) as f, open(corpus_json, "w") as g:
-                g.write(f.read())
-        commands["corpus"] = "(reused: %s)" % args.corpus_json
-    else:
-        commands["corpus"] = run_corpus(build, corpus_json)
-    if args.overhead_json:
-        if os.path.abspath(args.overhead_json) != overhead_json:
-            with open(args.overhead_json) as f, open(overhead_json, "w") as g:
-                g.write(f.read())
-        commands["overhead"] = "(reused: %s)" % args.overhead_json
-    else:
-        commands["overhead"] = run_overhead(build, overhead_json, args.rounds)
+    commands = {
+        "corpus": reuse(args.corpus_json, corpus_json) if args.corpus_json else run_corpus(build, corpus_json),
+        "overhead": (reuse(args.overhead_json, overhead_json) if args.overhead_json
+                     else run_overhead(build, overhead_json, args.rounds)),
+    }
     with open(corpus_json) as f:
         corpus = json.load(f)
     with open(overhead_json) as f:
@@ -411,6 +409,7 @@ def main():
         corpus["comparison_command"] = commands["corpus"]
     if not args.overhead_json:
         overhead["comparison_command"] = commands["overhead"]
+        overhead["comparison_asval"] = machine()["asval"]  # the commit measured, kept for regenerations
         with open(overhead_json, "w") as f:
             json.dump(overhead, f, indent=1)
     commands = {"corpus": corpus.get("comparison_command", commands["corpus"]),
@@ -444,7 +443,7 @@ def main():
            "Machine: " + "; ".join(str(part) for part in [
                "%s, %s cores" % (m.get("cpu"), m.get("cores")), m.get("os"), m.get("kernel"),
                m.get("driver"), "Vulkan loader %s" % m.get("loader"), "Khronos validation layer %s" % m.get("khronos_layer"),
-               "compiler %s" % m.get("compiler"), "asval %s" % m.get("asval", machine()["asval"])] if part) + ".",
+               "compiler %s" % m.get("compiler"), "asval %s" % overhead.get("comparison_asval", m.get("asval", machine()["asval"]))] if part) + ".",
            "",
            "Commands: corpus `%s`; overhead `%s`." % (commands["corpus"], commands["overhead"]),
            "Raw results: [comparison-corpus.json](comparison-corpus.json), "
