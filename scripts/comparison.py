@@ -21,8 +21,6 @@ import datetime
 import glob
 import json
 import os
-import platform
-import re
 import subprocess
 import sys
 
@@ -55,19 +53,8 @@ def sh(cmd):
                           universal_newlines=True).stdout.strip()
 
 
-def machine():
-    cpu = sh("sed -n 's/^model name[^:]*: //p' /proc/cpuinfo | head -1")
-    os_name = sh(". /etc/os-release && echo $PRETTY_NAME")
-    driver = sh("VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.json vulkaninfo --summary 2>/dev/null | "
-                "sed -n 's/^\\s*driverInfo *= //p' | head -1")
-    return {
-        "cpu": cpu, "cores": os.cpu_count(), "os": os_name, "kernel": platform.release(),
-        "compiler": sh("c++ --version | head -1"),
-        "driver": "lavapipe " + driver if driver else "unknown",
-        "loader": sh("dpkg-query -W -f='${Version}' libvulkan1"),
-        "khronos_layer": sh("dpkg-query -W -f='${Version}' vulkan-validationlayers"),
-        "asval": sh("git -C %s rev-parse --short HEAD" % ROOT),
-    }
+def asval_commit():
+    return sh("git -C %s rev-parse --short HEAD" % ROOT)
 
 
 def registry():
@@ -409,7 +396,7 @@ def main():
         corpus["comparison_command"] = commands["corpus"]
     if not args.overhead_json:
         overhead["comparison_command"] = commands["overhead"]
-        overhead["comparison_asval"] = machine()["asval"]  # the commit measured, kept for regenerations
+        overhead["comparison_asval"] = asval_commit()  # the commit measured, kept for regenerations
         with open(overhead_json, "w") as f:
             json.dump(overhead, f, indent=1)
     commands = {"corpus": corpus.get("comparison_command", commands["corpus"]),
@@ -423,7 +410,7 @@ def main():
 
     vuids = registry()
     named = khronos_named(vuids)
-    m = overhead.get("machine") or machine()
+    m = overhead["machine"]  # bench/overhead/overhead_machine.py says where the runs were made
     frame_overhead, frame_machine = overhead, m.get("driver", "this machine")
     if args.gpu_overhead_json:
         frame_overhead, frame_machine = load_gpu_overhead(args, docs), args.gpu_name
@@ -443,7 +430,7 @@ def main():
            "Machine: " + "; ".join(str(part) for part in [
                "%s, %s cores" % (m.get("cpu"), m.get("cores")), m.get("os"), m.get("kernel"),
                m.get("driver"), "Vulkan loader %s" % m.get("loader"), "Khronos validation layer %s" % m.get("khronos_layer"),
-               "compiler %s" % m.get("compiler"), "asval %s" % overhead.get("comparison_asval", m.get("asval", machine()["asval"]))] if part) + ".",
+               "compiler %s" % m.get("compiler"), "asval %s" % overhead.get("comparison_asval", asval_commit())] if part) + ".",
            "",
            "Commands: corpus `%s`; overhead `%s`." % (commands["corpus"], commands["overhead"]),
            "Raw results: [comparison-corpus.json](comparison-corpus.json), "

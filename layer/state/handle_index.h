@@ -14,7 +14,6 @@
 #include <cstdint>
 #include <vector>
 
-
 namespace asval {
 
 class HandleIndex {

@@ -113,9 +113,7 @@ class HistoryStore;
 class Transaction {
  public:
   bool empty() const { return entries_.empty(); }
-  void ReserveMore(std::size_t entries) {
-    entries_.reserve(entries_.size() + entries);
-  }
+  void ReserveMore(std::size_t entries) { entries_.reserve(entries_.size() + entries); }
   // Forgets every entry (the changes stay), keeping the capacity.
   void Clear() {
     entries_.clear();
@@ -188,7 +186,8 @@ class HistoryStore {
   void SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHistory history, Transaction* txn);
   // For an operation that rewrites the contents of a structure whose record knows its span: the record's history
   // becomes never built with `build` as its snapshot, without clobber, activity or serialization size, with the
-  // same span and a new generation, for the caller to fill in; the old one is kept for txn's undo. The span does not change, so it is not re-indexed.
+  // same span and a new generation, for the caller to fill in; the old one is kept for txn's undo. The span does
+  // not change, so it is not re-indexed.
   // The first rewrite of a record by a transaction writes the record's other history slot and keeps the old one
   // where it was (undo switches back: nothing is moved or copied into the log); later ones in the same
   // transaction, and those without one, move the old history into the log (or drop it).

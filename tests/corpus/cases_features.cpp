@@ -1,10 +1,7 @@
 // Family "features": the feature each build command needs, build modes, updates without a source, protected
 // command buffers. Lavapipe has neither accelerationStructureIndirectBuild nor accelerationStructureHostCommands,
 // so every indirect or host build on it also breaks 03650 / 03581: those cases carry that label too.
-#include <cctype>
-#include <cstdio>
 #include <cstring>
-#include <string>
 #include <vector>
 
 #include "corpus.h"
@@ -217,37 +214,6 @@ CORPUS_CASE(FeaturesBuildAndRefitOneCall, "features-build-one-refit-another-in-o
   scene.BuildNow({second.info, refit}, {ranges.data(), ranges.data()});
 }
 
-namespace {
-
-// The layers report to the messengers of the device's own instance, and the corpus program hands cases its device
-// only: the case without the feature makes an instance of its own and prints what that instance's messenger
-// receives in the corpus program's line format (the text left out: the runner reads severities and ids).
-VKAPI_ATTR VkBool32 VKAPI_CALL PrintToCorpus(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                             VkDebugUtilsMessageTypeFlagsEXT,
-                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
-  const bool error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  std::string id;
-  for (const char* c = data->pMessageIdName ? data->pMessageIdName : ""; *c; ++c) {
-    if (std::isalnum(static_cast<unsigned char>(*c)) || *c == '-' || *c == '_') id += *c;  // nothing to escape
-  }
-  std::printf("{\"severity\": \"%s\", \"id\": \"%s\", \"text\": \"\"}\n", error ? "error" : "warning", id.c_str());
-  std::fflush(stdout);
-  return error ? VK_TRUE : VK_FALSE;
-}
-
-uint32_t ComputeQueueFamily(VkPhysicalDevice gpu) {
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
-  for (uint32_t i = 0; i < count; ++i) {
-    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
-  }
-  return 0;
-}
-
-}  // namespace
-
 // A device created with VK_KHR_acceleration_structure but without enabling its accelerationStructure feature (an
 // app that forgot the feature structure in pNext), then an empty build recorded on it.
 CORPUS_CASE(FeaturesNoAccelerationStructureFeature, "features-build-without-as-feature",
@@ -258,63 +224,12 @@ CORPUS_CASE(FeaturesNoAccelerationStructureFeature, "features-build-without-as-f
              // No structure can be created without the feature (vkCreateAccelerationStructureKHR-03611), so the
              // build has no destination either.
              "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03800"}) {
-  VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  messenger_info.messageSeverity =
-      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
-  messenger_info.pfnUserCallback = &PrintToCorpus;
-  vkkit::InstanceOptions options;
-  options.layers = vkkit::LayersFromEnvironment();
-  options.pNext = &messenger_info;
-  vkkit::Instance instance(options);
-  auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance.handle(), "vkCreateDebugUtilsMessengerEXT"));
-  auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance.handle(), "vkDestroyDebugUtilsMessengerEXT"));
-  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-  vkkit::Check(create_messenger(instance.handle(), &messenger_info, nullptr, &messenger),
-               "vkCreateDebugUtilsMessengerEXT");
-  VkPhysicalDevice gpu = instance.FindRayTracingGpu();
-
-  const float priority = 1.0f;
-  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  queue.queueFamilyIndex = ComputeQueueFamily(gpu);
-  queue.queueCount = 1;
-  queue.pQueuePriorities = &priority;
-  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  v12.bufferDeviceAddress = VK_TRUE;
-  const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
-  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
-  info.queueCreateInfoCount = 1;
-  info.pQueueCreateInfos = &queue;
-  info.enabledExtensionCount = 2;
-  info.ppEnabledExtensionNames = extensions;
-  VkDevice featureless = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateDevice(gpu, &info, nullptr, &featureless), "vkCreateDevice");
-  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool_info.queueFamilyIndex = queue.queueFamilyIndex;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateCommandPool(featureless, &pool_info, nullptr, &pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  VkCommandBuffer cb = VK_NULL_HANDLE;
-  vkkit::Check(vkAllocateCommandBuffers(featureless, &alloc, &cb), "vkAllocateCommandBuffers");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
-  auto build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
-      vkGetDeviceProcAddr(featureless, "vkCmdBuildAccelerationStructuresKHR"));
+  asval_test::FeaturelessDevice featureless(corpus::CurrentInstance().FindRayTracingGpu());
   // The build names no structure (none can be created) and builds no geometry.
   VkAccelerationStructureBuildGeometryInfoKHR empty{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   empty.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   const VkAccelerationStructureBuildRangeInfoKHR* no_ranges = nullptr;
-  build(cb, 1, &empty, &no_ranges);
-  vkEndCommandBuffer(cb);
-  vkDestroyCommandPool(featureless, pool, nullptr);
-  vkDestroyDevice(featureless, nullptr);
-  destroy_messenger(instance.handle(), messenger, nullptr);
+  featureless.CmdBuild(featureless.cb(), 1, &empty, &no_ranges);
 }
 
 // An app that reuses its refit info for a full rebuild and leaves srcAccelerationStructure set (to the structure

@@ -24,6 +24,10 @@ struct Case {
 // Every case of the program, in registration order.
 std::vector<Case>& Cases();
 
+// The instance the running case's device belongs to, with the corpus messenger attached (for a case that makes a
+// device of its own, e.g. without a feature the case is about).
+vkkit::Instance& CurrentInstance();
+
 struct Registrar {
   explicit Registrar(Case c) { Cases().push_back(std::move(c)); }
 };

@@ -19,6 +19,8 @@ std::vector<Case>& Cases() {
 
 namespace {
 
+vkkit::Instance* current_instance = nullptr;
+
 std::string Json(const std::string& s) {
   std::string out = "\"";
   for (const char c : s) {
@@ -83,15 +85,20 @@ int Run(const Case& c) {
     std::fprintf(stderr, "asval_corpus: no device with VK_KHR_acceleration_structure\n");
     return 2;
   }
+  current_instance = &instance;
   {
     vkkit::Device device(instance, gpu);
     c.body(device);
-  }  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too
+  }
+  current_instance = nullptr;  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too
   destroy(instance.handle(), messenger, nullptr);
   return 0;
 }
 
 }  // namespace
+
+vkkit::Instance& CurrentInstance() { return *current_instance; }
+
 }  // namespace corpus
 
 int main(int argc, char** argv) {

@@ -26,6 +26,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "bench", "overhead"))
+import overhead_env  # noqa: E402  (--config's syntax: one parser for the corpus and the overhead benchmark)
 ALIASES_FILE = os.path.join(ROOT, "scripts", "vuids_newer.json")
 KHRONOS_MANIFEST_DIR = "/usr/share/vulkan/explicit_layer.d"
 ASVAL = "VK_LAYER_ASVAL_as_validation"
@@ -102,18 +104,9 @@ def configurations(layer_path, extra, driver_files):
         "asval": dict(base, ASVAL_TEST_LAYERS=ASVAL, VK_INSTANCE_LAYERS=ASVAL),
         "khronos": dict(base, ASVAL_TEST_LAYERS=KHRONOS, VK_INSTANCE_LAYERS=KHRONOS),
     }
-    for spec in extra:
-        name, _, settings = spec.partition(":")
-        env = dict(configs["asval"])
-        key = None
-        for part in settings.split(","):
-            # A part that is not ENV=... continues the value before it (ENABLED_CHECKS=features,handles).
-            if re.match(r"^[A-Za-z_][A-Za-z0-9_]*=", part) or key is None:
-                key, _, value = part.partition("=")
-                env[key] = value
-            else:
-                env[key] += "," + part
-        configs[name] = env
+    for spec in extra:  # NAME:ENV=VALUE,... read as the overhead benchmark reads its own --config
+        config = overhead_env.parse_config(spec)
+        configs[config.name] = dict(configs["asval"], **config.env)
     return configs
 
 

@@ -28,64 +28,19 @@ void ExpectMissingFeature(Monitor& monitor, Command command) {
   if (command != Command::kDirect) monitor.Expect(kFeature.For(command));
 }
 
-uint32_t ComputeQueueFamily(VkPhysicalDevice gpu) {
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
-  for (uint32_t i = 0; i < count; ++i) {
-    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
-  }
-  return 0;
-}
-
 TEST_CASE("08923: a build on a device without the accelerationStructure feature is reported",
           "[integration][features][08923]") {
   CheckFixture f("features");
-  VkPhysicalDevice gpu = f.instance().FindRayTracingGpu();
   // The extension without its feature: a valid device, on which no build may be recorded.
-  const float priority = 1.0f;
-  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  queue.queueFamilyIndex = ComputeQueueFamily(gpu);
-  queue.queueCount = 1;
-  queue.pQueuePriorities = &priority;
-  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  v12.bufferDeviceAddress = VK_TRUE;
-  const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
-  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
-  info.queueCreateInfoCount = 1;
-  info.pQueueCreateInfos = &queue;
-  info.enabledExtensionCount = 2;
-  info.ppEnabledExtensionNames = extensions;
-  VkDevice device = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateDevice(gpu, &info, nullptr, &device), "vkCreateDevice");
-  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool_info.queueFamilyIndex = queue.queueFamilyIndex;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateCommandPool(device, &pool_info, nullptr, &pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  VkCommandBuffer cb = VK_NULL_HANDLE;
-  vkkit::Check(vkAllocateCommandBuffers(device, &alloc, &cb), "vkAllocateCommandBuffers");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
-
-  auto build = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
-      vkGetDeviceProcAddr(device, "vkCmdBuildAccelerationStructuresKHR"));
+  FeaturelessDevice featureless(f.instance().FindRayTracingGpu());
+  auto build = featureless.CmdBuild;
   REQUIRE(build);
   VkAccelerationStructureBuildGeometryInfoKHR empty{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
   empty.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   const VkAccelerationStructureBuildRangeInfoKHR* no_ranges = nullptr;
   f.monitor().Expect(kFeature.direct);
-  build(cb, 1, &empty, &no_ranges);
+  build(featureless.cb(), 1, &empty, &no_ranges);
   CHECK(f.monitor().Verify() == "");
-
-  vkkit::Check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
-  vkDestroyCommandPool(device, pool, nullptr);
-  vkDestroyDevice(device, nullptr);
 }
 
 TEST_CASE("08923 valid twin: with the feature enabled a build stays silent", "[integration][features][08923]") {

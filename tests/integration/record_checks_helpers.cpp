@@ -252,4 +252,51 @@ std::vector<VkAccelerationStructureBuildRangeInfoKHR> Ranges(size_t geometries, 
                                                                                count, 0, 0, 0});
 }
 
+uint32_t ComputeQueueFamily(VkPhysicalDevice gpu) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
+  for (uint32_t i = 0; i < count; ++i) {
+    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+  }
+  return 0;
+}
+
+FeaturelessDevice::FeaturelessDevice(VkPhysicalDevice gpu) {
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue.queueFamilyIndex = ComputeQueueFamily(gpu);
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  v12.bufferDeviceAddress = VK_TRUE;
+  const char* extensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &v12};
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  info.enabledExtensionCount = 2;
+  info.ppEnabledExtensionNames = extensions;
+  vkkit::Check(vkCreateDevice(gpu, &info, nullptr, &device_), "vkCreateDevice");
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.queueFamilyIndex = queue.queueFamilyIndex;
+  vkkit::Check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool_), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  vkkit::Check(vkAllocateCommandBuffers(device_, &alloc, &cb_), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkkit::Check(vkBeginCommandBuffer(cb_, &begin), "vkBeginCommandBuffer");
+  CmdBuild = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(
+      vkGetDeviceProcAddr(device_, "vkCmdBuildAccelerationStructuresKHR"));
+}
+
+FeaturelessDevice::~FeaturelessDevice() {
+  vkEndCommandBuffer(cb_);
+  vkDestroyCommandPool(device_, pool_, nullptr);
+  vkDestroyDevice(device_, nullptr);
+}
+
 }  // namespace asval_test

@@ -113,4 +113,24 @@ class Scene {
 // Ranges of `count` primitives at offset 0 for each of `geometries` geometries.
 std::vector<VkAccelerationStructureBuildRangeInfoKHR> Ranges(size_t geometries, uint32_t count = 1);
 
+// The first queue family of `gpu` with compute.
+uint32_t ComputeQueueFamily(VkPhysicalDevice gpu);
+
+// A device with VK_KHR_acceleration_structure enabled but not its accelerationStructure feature (an app that forgot
+// the feature structure): a valid device on which no build may be recorded. One primary command buffer, begun.
+class FeaturelessDevice {
+ public:
+  explicit FeaturelessDevice(VkPhysicalDevice gpu);
+  ~FeaturelessDevice();
+  FeaturelessDevice(const FeaturelessDevice&) = delete;
+  FeaturelessDevice& operator=(const FeaturelessDevice&) = delete;
+  VkCommandBuffer cb() const { return cb_; }
+  PFN_vkCmdBuildAccelerationStructuresKHR CmdBuild = nullptr;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer cb_ = VK_NULL_HANDLE;
+};
+
 }  // namespace asval_test
