@@ -162,7 +162,8 @@ bool ValidateInstanceReferences(const CheckContext& ctx, const BuildCommand& cmd
 bool ValidateHostInputs(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
                         std::vector<uint64_t>& references) {
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
-  if (!cmd.ranges || !cmd.ranges[i]) return false;
+  // Past maxGeometryCount the arrays may be shorter than the count (type-03793 covers the info).
+  if (!cmd.ranges || !cmd.ranges[i] || !GeometriesWalkable(ctx, info)) return false;
   bool skip = false;
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     const VkAccelerationStructureGeometryKHR* g = GeometryAt(info, j);
