@@ -79,6 +79,7 @@ void ResolveDestinations(const DeviceState& state, uint32_t info_count,
     signature.info = &infos[i];
     BuildSizes sizes;
     if (!ranges[i] && infos[i].geometryCount != 0) continue;
+    if (!GeometryCountWithinLimit(infos[i], state.properties.acceleration_structure.maxGeometryCount)) continue;
     signature.counts = ranges[i] ? &ranges[i][0].primitiveCount : nullptr;
     signature.count_stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
     if (infos[i].geometryCount != 0 && !state.build_sizes.Find(signature, &sizes)) continue;

@@ -49,8 +49,7 @@ template <typename MakeLocation, typename... Args>
 // walking an absurd count would cost the layer what the driver never spends.
 inline bool GeometriesWalkable(const CheckContext& ctx, const VkAccelerationStructureBuildGeometryInfoKHR& info) {
   if (!info.pGeometries && !info.ppGeometries) return false;
-  const uint64_t limit = ctx.state.properties.acceleration_structure.maxGeometryCount;
-  return info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR || limit == 0 || info.geometryCount <= limit;
+  return GeometryCountWithinLimit(info, ctx.state.properties.acceleration_structure.maxGeometryCount);
 }
 
 // Counts a check that could not run because the state it needs is unknown (never guessed).

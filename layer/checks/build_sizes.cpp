@@ -178,6 +178,9 @@ bool SizeQueryIsValid(const DeviceState& state, const BuildSignature& signature)
 
 std::optional<BuildSizes> SizesOfInfo(const DeviceState& state, const BuildCommand& cmd, uint32_t i,
                                       BuildSizeCache::ThreadTable* table) {
+  if (!GeometryCountWithinLimit(cmd.infos[i], state.properties.acceleration_structure.maxGeometryCount)) {
+    return std::nullopt;  // type-03793 says it; the arrays may be shorter than the count
+  }
   BuildSignature signature;
   BuildSizes sizes;
   if (SignatureOf(cmd, i, &signature)) {

@@ -60,6 +60,15 @@ struct BuildSignature {
   bool Cacheable() const;
 };
 
+// Whether a build info's geometries stay within maxGeometryCount (bottom level; a limit of 0 was not reported).
+// Past it the build is invalid as a whole (type-03793) and its arrays may be shorter than its count: nothing may
+// walk them, neither a signature (Find) nor the driver's size query.
+inline bool GeometryCountWithinLimit(const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                                     uint64_t max_geometry_count) {
+  return info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR || max_geometry_count == 0 ||
+         info.geometryCount <= max_geometry_count;
+}
+
 class BuildSizeCache {
  public:
   using QueryFn = PFN_vkGetAccelerationStructureBuildSizesKHR;
@@ -152,6 +161,8 @@ class BuildSizeCache {
   Shard& ShardFor(uint64_t hash) const { return shards_[hash >> 60]; }
 
   // Remembers a signature by its arrays in the calling thread's table.
+  // A driver's answer stored in the shared map and this thread's table (may throw std::bad_alloc: Query catches).
+  void Remember(const BuildSignature& signature, const BuildSizes& sizes) const;
   void RememberByArrays(ThreadTable& table, const BuildSignature& signature, const uint64_t* words, std::size_t count,
                         const BuildSizes& sizes) const;
   // Stores a hit in the calling thread's table.
