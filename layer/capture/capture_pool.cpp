@@ -87,6 +87,7 @@ bool CapturePool::Take(VkDeviceSize bytes, CaptureSlab* slab) {
         *slab = free_[k];
         free_[k] = free_.back();
         free_.pop_back();
+        peak_in_use_ = std::max(peak_in_use_, all_.size() - free_.size());
         return true;
       }
     }
@@ -94,7 +95,16 @@ bool CapturePool::Take(VkDeviceSize bytes, CaptureSlab* slab) {
   if (!Create(wanted, slab)) return false;
   std::lock_guard<std::mutex> lock(mutex_);
   all_.push_back(*slab);
+  peak_in_use_ = std::max(peak_in_use_, all_.size() - free_.size());
   return true;
+}
+
+void CapturePool::AddFootprint(CaptureFootprint* out) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  out->slabs += all_.size();
+  out->slabs_in_use += all_.size() - free_.size();
+  for (const CaptureSlab& slab : all_) out->slab_bytes += slab.size;
+  out->peak_slabs_in_use += peak_in_use_;
 }
 
 void CapturePool::Return(const CaptureSlab& slab) {

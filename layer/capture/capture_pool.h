@@ -11,6 +11,7 @@
 
 #include "capture_log.h"
 #include "capture_reducer.h"
+#include "footprint.h"
 #include "vk_dispatch_table.h"
 
 namespace asval {
@@ -32,6 +33,8 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   void Return(const CaptureSlab& slab) override;
   // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
   void Shutdown();
+  // Adds its slabs to the layer's footprint (footprint.h).
+  void AddFootprint(CaptureFootprint* out);
   // The capture reduces on the device (CaptureLog::TableIndexOf says where a slab is in the table).
   bool reduces() const { return reduces_; }
   // The reducing pipeline (compiled at the first call; null when it could not be: the captures are then copied).
@@ -49,6 +52,7 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   std::mutex mutex_;
   std::vector<CaptureSlab> free_;
   std::vector<CaptureSlab> all_;  // every live slab, for Shutdown
+  std::size_t peak_in_use_ = 0;   // the most slabs taken at once (footprint)
   bool shut_down_ = false;
 };
 

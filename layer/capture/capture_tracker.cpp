@@ -65,6 +65,14 @@ void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence
   p.captures = std::move(captures);
   pending_.push_back(std::move(p));
   pending_count_.fetch_add(1, std::memory_order_release);
+  peak_pending_ = std::max(peak_pending_, pending_.size());
+}
+
+void CaptureTracker::AddFootprint(CaptureFootprint* out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  out->pending_submissions += pending_.size();
+  out->peak_pending_submissions += peak_pending_;
+  out->spare_fences += free_fences_.size();
 }
 
 void CaptureTracker::ReturnFence(VkFence fence) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "build_activity.h"
+#include "footprint.h"
 #include "vk_dispatch_table.h"
 
 namespace asval {
@@ -60,6 +61,8 @@ class CaptureTracker {
   // their layer fence); stops at the first one still pending. A call made while this thread is processing (from
   // an app callback) does nothing.
   void Process(const Covered& covered, const OnComplete& on_complete);
+  // Adds its pending submissions and spare fences to the layer's footprint (footprint.h).
+  void AddFootprint(CaptureFootprint* out) const;
   // No submission pending (one atomic load: asked at every submission and wait).
   bool idle() const { return pending_count_.load(std::memory_order_acquire) == 0; }
 
@@ -81,6 +84,7 @@ class CaptureTracker {
   std::deque<Pending> pending_;
   std::atomic<std::size_t> pending_count_{0};
   std::vector<VkFence> free_fences_;
+  std::size_t peak_pending_ = 0;  // the most submissions pending at once (footprint)
 };
 
 }  // namespace asval

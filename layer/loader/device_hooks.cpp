@@ -1,5 +1,6 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include "footprint_report.h"
 #include "history_host.h"
 #include "layer_data.h"
 #include "state_tracker.h"
@@ -11,6 +12,8 @@ namespace asval::hooks {
 VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCallbacks* pAllocator) {
   if (!device) return;
   std::unique_ptr<DeviceData> data = Devices().Remove(GetDispatchKey(device));
+  if (data) ReportFootprint(ComputeFootprint(data->state, data->capture_pool.get(), data->capture_tracker.get()),
+                            *data->reporter, device);
   if (data && data->capture_tracker) {
     // The app waited for the device to be idle (it must, to destroy it): everything captured is read now.
     CaptureTracker::Covered all;

@@ -115,6 +115,12 @@ class CommandBufferMap {
   // commands' commandBuffer-09547 is a single load and no map lookup: protected memory is rare.
   bool AnyProtectedPool() const { return any_protected_pool_.load(std::memory_order_acquire); }
   std::size_t size() const { return buffers_.size(); }
+  // Every command buffer's state (footprint.h counts what they hold).
+  std::vector<std::shared_ptr<CommandBufferState>> All() const {
+    std::vector<std::shared_ptr<CommandBufferState>> out;
+    for (auto& [cb, state] : buffers_.snapshot()) out.push_back(std::move(state));
+    return out;
+  }
   // Changes to the set of command buffers so far (allocations, frees, pool destruction): while it reads the
   // same, a CommandBufferState found before is still the one the map holds (history_recorder.cpp keeps the
   // last one it recorded into).

@@ -71,6 +71,7 @@ uint32_t HistoryStore::Insert(VkAccelerationStructureKHR as, AsHistory history, 
     records_.emplace_back(std::move(history), version);
   }
   index_.Insert(reinterpret_cast<uint64_t>(as), record);
+  peak_records_ = std::max(peak_records_, index_.size());
   Index(record, as);
   return record;
 }
@@ -165,6 +166,7 @@ uint64_t HistoryStore::AddBlob(SerializedBlob blob, Transaction* txn) {
   blob.valid = true;
   Push(txn, Transaction::Kind::kBlobAdded, blob.id);
   blobs_.push_back(std::move(blob));
+  peak_blobs_ = std::max(peak_blobs_, blobs_.size());
   return blob_counter_;
 }
 
@@ -230,6 +232,7 @@ void HistoryStore::SetSlot(VkQueryPool pool, uint32_t query, const QuerySlot& sl
     txn->slots_.push_back(std::move(change));
   }
   slots_[key] = SlotRecord{slot, version};
+  peak_query_slots_ = std::max(peak_query_slots_, slots_.size());
 }
 
 const QuerySlot* HistoryStore::FindSlot(VkQueryPool pool, uint32_t query) const {

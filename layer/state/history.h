@@ -254,6 +254,16 @@ class HistoryStore {
 
   std::size_t size() const { return index_.size(); }
 
+  // What the store holds, and the most it held at once (the layer's footprint, footprint.h).
+  struct Sizes {
+    std::size_t records = 0, record_slots = 0, spans = 0, blobs = 0, query_slots = 0, spare_transactions = 0;
+    std::size_t peak_records = 0, peak_blobs = 0, peak_query_slots = 0;
+  };
+  Sizes sizes() const {
+    return Sizes{index_.size(), records_.size(), spans_.size(), blobs_.size(), slots_.size(),
+                 spare_transactions_.size(), peak_records_, peak_blobs_, peak_query_slots_};
+  }
+
   // Counters, readable without the lock.
   mutable std::atomic<uint64_t> ops_applied{0};
   mutable std::atomic<uint64_t> rules_skipped_unknown_history{0};  // history checks skipped: unknown history
@@ -334,6 +344,7 @@ class HistoryStore {
   uint64_t generation_counter_ = 0;
   uint64_t version_counter_ = 0;
   uint64_t blob_counter_ = 0;
+  std::size_t peak_records_ = 0, peak_blobs_ = 0, peak_query_slots_ = 0;  // Sizes
 };
 
 template <typename F>

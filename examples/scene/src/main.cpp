@@ -8,6 +8,7 @@
 
 #include "faults.h"
 #include "findings.h"
+#include "frame_checkpoints.h"
 #include "gpu.h"
 #include "inject.h"
 #include "options.h"
@@ -15,6 +16,19 @@
 #include "vkkit.h"
 
 namespace {
+
+// Prints the --checkpoints lines while the scene runs its frames.
+class FrameCheckpointsHook {
+ public:
+  FrameCheckpointsHook(scene::Scene& world, const scene::SceneOptions& options) : checkpoints_(options.checkpoints) {
+    if (options.checkpoints.empty()) return;
+    checkpoints_.Start();
+    world.after_frame = [this](uint32_t frames_done) { checkpoints_.AfterFrame(frames_done); };
+  }
+
+ private:
+  scene::FrameCheckpoints checkpoints_;
+};
 
 int Run(const scene::SceneOptions& options) {
   scene::Findings findings;
@@ -45,6 +59,7 @@ int Run(const scene::SceneOptions& options) {
       std::printf("deforming: %u inactive triangles (NaN), %u degenerate at the first build\n",
                   world.deforming.meshes().inactive_triangles, world.deforming.meshes().degenerate_triangles);
       std::fflush(stdout);
+      FrameCheckpointsHook checkpoints(world, options);
       world.RunFrames();
       if (!options.out.empty()) world.WriteImage(options.out);
       if (options.fault) scene::InjectFault(world, *options.fault);

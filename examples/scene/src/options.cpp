@@ -1,5 +1,6 @@
 #include "options.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <utility>
@@ -18,6 +19,22 @@ bool ParseCount(const char* text, uint32_t min, uint32_t max, uint32_t* value) {
   return true;
 }
 
+// "100,1000,10000": ascending counts of 1..100000.
+bool ParseCheckpoints(const char* text, std::vector<uint32_t>* out) {
+  out->clear();
+  std::string list = text;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', begin), list.size());
+    uint32_t n = 0;
+    if (!ParseCount(list.substr(begin, comma - begin).c_str(), 1, 100000, &n)) return false;
+    if (!out->empty() && n <= out->back()) return false;
+    out->push_back(n);
+    begin = comma + 1;
+  }
+  return true;
+}
+
 bool Fail(std::string* error, std::string message) {
   *error = std::move(message);
   return false;
@@ -27,6 +44,7 @@ bool Fail(std::string* error, std::string message) {
 
 const char* Usage() {
   return "usage: asval_scene [--frames N] [--instances N] [--size WxH] [--static] [--out FILE.png] [--inject FAULT]\n"
+         "                   [--checkpoints N,N,...]\n"
          "       asval_scene --list-faults\n"
          "Renders an animated ray-traced scene without a window (any device with VK_KHR_acceleration_structure\n"
          "and VK_KHR_ray_tracing_pipeline). Layers come from the environment (VK_INSTANCE_LAYERS).\n"
@@ -37,6 +55,8 @@ const char* Usage() {
          "                  refit or top-level update)\n"
          "  --out FILE      write the last frame as PNG\n"
          "  --inject FAULT  after the frames, commit one rule violation (see --list-faults)\n"
+         "  --checkpoints N,N,...  after each of these frame counts, print the process's resident memory (now and\n"
+         "                  peak) and the wall time per frame of the 100 frames before (bench/longrun)\n"
          "  --list-faults   print each fault with the VUID it must trigger\n";
 }
 
@@ -63,12 +83,19 @@ bool ParseOptions(int argc, char** argv, SceneOptions* o, std::string* error) {
       }
     } else if (std::strcmp(a, "--out") == 0 && has_value) {
       o->out = argv[++i];
+    } else if (std::strcmp(a, "--checkpoints") == 0 && has_value) {
+      if (!ParseCheckpoints(argv[++i], &o->checkpoints)) {
+        return Fail(error, "--checkpoints: expected ascending frame counts separated by commas, e.g. 100,1000");
+      }
     } else if (std::strcmp(a, "--inject") == 0 && has_value) {
       o->fault = FindFault(argv[++i]);
       if (!o->fault) return Fail(error, std::string("--inject: unknown fault '") + argv[i] + "' (see --list-faults)");
     } else {
       return Fail(error, std::string("unknown or incomplete argument '") + a + "'");
     }
+  }
+  if (!o->checkpoints.empty() && o->checkpoints.back() > o->frames) {
+    return Fail(error, "--checkpoints: " + std::to_string(o->checkpoints.back()) + " is past --frames");
   }
   return true;
 }

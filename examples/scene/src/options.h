@@ -2,6 +2,7 @@
 // The scene's command line.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace scene {
 
@@ -15,6 +16,8 @@ struct SceneOptions {
   std::string out;                   // PNG path; empty: no image written
   const FaultInfo* fault = nullptr;  // --inject
   bool static_scene = false;  // --static: structures built once, frames only trace rays
+  // --checkpoints: frame counts (ascending, at most `frames`) after which memory and frame times are printed.
+  std::vector<uint32_t> checkpoints;
   bool list_faults = false;
   bool help = false;
 };

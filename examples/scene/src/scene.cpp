@@ -108,6 +108,7 @@ void Scene::RunFrames() {
     Frame(f);
     if (f == 0) after_first = Clock::now();
     ++frames_done_;
+    if (after_frame) after_frame(frames_done_);
   }
   const double first_ms = std::chrono::duration<double, std::milli>(after_first - start).count();
   const double rest_s = std::chrono::duration<double>(Clock::now() - after_first).count();

@@ -29,6 +29,9 @@ class Scene {
   Scene& operator=(const Scene&) = delete;
 
   void RunFrames();
+  // Called after each frame with the number of frames done (the long-run checkpoints, frame_checkpoints.h);
+  // empty: nothing is called.
+  std::function<void(uint32_t frames_done)> after_frame;
   void WriteImage(const std::string& path) const;
 
   static float TimeOf(uint32_t frame) { return 0.1f * static_cast<float>(frame); }
