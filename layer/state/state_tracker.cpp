@@ -143,7 +143,11 @@ void RecordCreateQueryPool(DeviceState& state, const VkQueryPoolCreateInfo& info
 
 void RecordDestroyQueryPool(DeviceState& state, VkQueryPool pool) {
   std::optional<QueryPoolState> record = state.history.query_pools.pop(pool);
-  if (record && record->type == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) {
+  // Every pool that vkCmdWriteAccelerationStructuresPropertiesKHR may have written slots of (compacted sizes too,
+  // not only serialization sizes): otherwise an app that makes a compaction query pool per frame leaves its slots
+  // in the store for good (found by the long run's footprint, issue 14).
+  if (record && record->type != VK_QUERY_TYPE_OCCLUSION && record->type != VK_QUERY_TYPE_PIPELINE_STATISTICS &&
+      record->type != VK_QUERY_TYPE_TIMESTAMP) {
     std::unique_lock<std::mutex> lock = state.history.store.Lock();
     state.history.store.ForgetPool(pool);
   }
