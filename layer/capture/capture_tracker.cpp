@@ -152,11 +152,13 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       if (!done) break;  // still pending (or the device was lost): later, in order
       current = std::move(p);
       pending_.pop_front();
-      pending_count_.fetch_sub(1, std::memory_order_release);
     }
     on_complete(current.captures);
     std::lock_guard<std::mutex> lock(mutex_);
     Retire(current);
+    // Pending until its findings are out: a wait hook that finds the tracker idle returns at once, and must not
+    // return before another thread's processing of the submission it waited for has reported.
+    pending_count_.fetch_sub(1, std::memory_order_release);
   }
   t_processing = false;
 }
