@@ -1,6 +1,9 @@
 #include "capture_pool.h"
 
 #include <algorithm>
+#include <new>
+
+#include "failure_injection.h"
 
 namespace asval {
 
@@ -40,6 +43,10 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
   CaptureSlab s;
   s.size = bytes;
   if (next_.CreateBuffer(device_, &info, nullptr, &s.buffer) != VK_SUCCESS) return false;
+  if (InjectedFailure(FailSite::kCaptureMemory)) {  // the test hook: as if vkAllocateMemory ran out of memory
+    next_.DestroyBuffer(device_, s.buffer, nullptr);
+    return false;
+  }
   VkMemoryRequirements requirements{};
   next_.GetBufferMemoryRequirements(device_, s.buffer, &requirements);
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
@@ -92,9 +99,28 @@ bool CapturePool::Take(VkDeviceSize bytes, CaptureSlab* slab) {
       }
     }
   }
+  {
+    // Room for the new slab in both lists before it exists: a slab not listed would outlive the device, and
+    // Return (called by a capture log's destructor) must never allocate.
+    std::lock_guard<std::mutex> lock(mutex_);
+    try {
+      all_.reserve(all_.size() + 1);
+      free_.reserve(all_.size() + 1);
+    } catch (const std::bad_alloc&) {
+      return false;  // no slab: the capture is skipped and counted
+    }
+  }
   if (!Create(wanted, slab)) return false;
   std::lock_guard<std::mutex> lock(mutex_);
-  all_.push_back(*slab);
+  try {
+    all_.push_back(*slab);  // another thread's slab may have taken the room reserved above
+    free_.reserve(all_.size());
+  } catch (const std::bad_alloc&) {
+    if (all_.empty() || all_.back().buffer != slab->buffer) {
+      Destroy(*slab);
+      return false;
+    }
+  }
   peak_in_use_ = std::max(peak_in_use_, all_.size() - free_.size());
   return true;
 }
@@ -110,6 +136,9 @@ void CapturePool::AddFootprint(CaptureFootprint* out) {
 void CapturePool::Return(const CaptureSlab& slab) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (shut_down_) return;  // destroyed with the device already
+  // Never allocates (a capture log's destructor calls it): the room is reserved when a slab is made. Without it
+  // (a reservation that failed) the slab is not reused, only destroyed with the others at Shutdown.
+  if (free_.size() == free_.capacity()) return;
   free_.push_back(slab);
 }
 

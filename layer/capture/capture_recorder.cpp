@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <new>
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
 #include "capture_buffers.h"
 #include "capture_plan.h"
 #include "capture_reduce_jobs.h"
+#include "failure_injection.h"
 #include "history.h"
 #include "structure_memory.h"
 
@@ -58,6 +60,43 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
 void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies) {
   RecordCaptures(ctx, cb, copies, Dispatch{}, VK_NULL_HANDLE);
 }
+
+// Room in the recording's slabs; false only when the pool could not give a slab (the device's memory, or the
+// layer's vkCreateBuffer / vkAllocateMemory / vkMapMemory, failed): counted as a capture memory failure.
+bool Reserve(const CaptureContext& ctx, CaptureLog& log, VkDeviceSize size, CapturedBytes* where) {
+  if (log.Reserve(size, where)) return true;
+  ctx.counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+// An allocation of the capture's own failed while it recorded a command's copies, before any was recorded: the
+// command captures nothing (its rules skipped and counted as for bytes not captured), and `needing` infos that
+// needed a capture are counted as not captured.
+bool CaptureDropped(const CaptureContext& ctx, uint64_t needing, std::vector<uint32_t>& captured) {
+  captured.clear();
+  FailureCounters& failures = ctx.counters.failures;
+  failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  failures.capture_commands_dropped.fetch_add(1, std::memory_order_relaxed);
+  ctx.counters.infos_not_captured.fetch_add(needing, std::memory_order_relaxed);
+  return false;
+}
+
+// The public functions below, but an allocation failure throws (before anything is recorded into cb: each
+// records its commands last); the public ones catch it.
+uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                                      VkDeviceAddress address, VkAccelerationStructureKHR src);
+
+// What a command's captures add to the counters, added once its copies are recorded (a command dropped by an
+// allocation failure adds nothing but its infos not captured).
+struct CommandCounts {
+  uint64_t captured = 0, bytes = 0, not_captured = 0, over_budget = 0;
+  void AddTo(CaptureCounters& counters) const {
+    counters.infos_captured.fetch_add(captured, std::memory_order_relaxed);
+    counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
+    counters.infos_not_captured.fetch_add(not_captured, std::memory_order_relaxed);
+    counters.infos_over_budget.fetch_add(over_budget, std::memory_order_relaxed);
+  }
+};
 
 // The destinations of a build command of several infos, for the rules about its top-level infos' instances and
 // its other destinations (None-03407, dstAccelerationStructure-03706), judged once the instances are captured.
@@ -115,49 +154,63 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       !ctx.next.CmdPipelineBarrier) {
     return false;
   }
-  // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
-  thread_local std::vector<Copy> copies;
-  // No geometry data (only the range infos are captured): the facts their rules need.
-  thread_local std::vector<CapturedGeometry> planned;
-  copies.clear();
+  uint64_t needing = 0;
   for (uint32_t i = 0; i < info_count; ++i) {
-    const uint32_t n = infos[i].geometryCount;
-    if (n == 0 || !max_primitive_counts[i] || addresses[i] == 0) continue;
-    if (captured.empty()) captured.assign(info_count, 0);
-    CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
-    CapturedInfo entry;
-    entry.indirect = true;
-    entry.geometry_count = n;
-    entry.indirect_stride = strides[i];
-    const VkDeviceSize bytes =
-        SaturatingAddBytes(SaturatingMulBytes(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
-    const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
-    if (!within_budget) ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
-    const std::optional<AddressHit> hit =
-        within_budget ? CaptureSourceBuffer(ctx.state, addresses[i], bytes, CaptureRead::kCopy) : std::nullopt;
-    if (hit && log.Reserve(bytes, &entry.ranges)) {
-      copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
-                            VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
-      ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
-      ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
-    } else {
-      entry.complete = false;
-      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
-    }
-    planned.assign(n, CapturedGeometry{});
-    for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
-    captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
+    needing += infos[i].geometryCount != 0 && max_primitive_counts[i] && addresses[i] != 0;
   }
-  if (!copies.empty()) RecordCopies(ctx, cb, copies);
-  return !captured.empty();
+  try {
+    InjectBadAlloc(FailSite::kCaptureRecord);
+    // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
+    thread_local std::vector<Copy> copies;
+    // No geometry data (only the range infos are captured): the facts their rules need.
+    thread_local std::vector<CapturedGeometry> planned;
+    copies.clear();
+    CommandCounts counts;
+    for (uint32_t i = 0; i < info_count; ++i) {
+      const uint32_t n = infos[i].geometryCount;
+      if (n == 0 || !max_primitive_counts[i] || addresses[i] == 0) continue;
+      if (captured.empty()) captured.assign(info_count, 0);
+      CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
+      CapturedInfo entry;
+      entry.indirect = true;
+      entry.geometry_count = n;
+      entry.indirect_stride = strides[i];
+      const VkDeviceSize bytes =
+          SaturatingAddBytes(SaturatingMulBytes(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
+      const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
+      if (!within_budget) ++counts.over_budget;
+      const std::optional<AddressHit> hit =
+          within_budget ? CaptureSourceBuffer(ctx.state, addresses[i], bytes, CaptureRead::kCopy) : std::nullopt;
+      if (hit && Reserve(ctx, log, bytes, &entry.ranges)) {
+        copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
+                              VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
+        ++counts.captured;
+        counts.bytes += bytes;
+      } else {
+        entry.complete = false;
+        ++counts.not_captured;
+      }
+      planned.assign(n, CapturedGeometry{});
+      for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
+      captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
+    }
+    if (!copies.empty()) RecordCopies(ctx, cb, copies);
+    counts.AddTo(ctx.counters);
+    return !captured.empty();
+  } catch (const std::bad_alloc&) {
+    return CaptureDropped(ctx, needing, captured);
+  }
 }
 
-bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
-                        uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                        const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
-                        std::vector<uint32_t>& captured) {
-  captured.clear();
-  if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
+namespace {
+
+// CaptureBuildInputs, but an allocation failure throws (before anything is recorded into cb: the copies are
+// recorded last).
+bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                               uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                               const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                               std::vector<uint32_t>& captured) {
+  InjectBadAlloc(FailSite::kCaptureRecord);
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
   thread_local std::vector<Copy> copies;
   thread_local std::vector<CaptureSource> sources;
@@ -166,6 +219,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   thread_local std::vector<CommandDestination> destinations;
   copies.clear();
+  CommandCounts counts;
   // capture_method reduce: one dispatch for the command, its jobs in one block, taken at the first capture.
   JobBlock block;
   bool block_tried = !ctx.pool.reduces();
@@ -179,7 +233,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
     const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
     if (!info_ranges || (!info.pGeometries && !info.ppGeometries) || motion) {
-      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+      ++counts.not_captured;
       continue;
     }
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
@@ -189,7 +243,11 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
         if (NeedsCapture(ctx.mode, infos[k])) jobs += std::min(infos[k].geometryCount, kReduceMaxJobsPerDispatch + 1);
         jobs = std::min(jobs, kReduceMaxJobsPerDispatch + 1);
       }
-      block.Acquire(log, jobs, ctx.pool.ReducePipeline());
+      const VkPipeline pipeline = ctx.pool.ReducePipeline();
+      if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
+        ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
+      }
+      block.Acquire(log, jobs, pipeline);
       block_tried = true;
     }
     CapturedInfo entry;
@@ -229,7 +287,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     }
     if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
       entry.complete = false;
-      ctx.counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
+      ++counts.over_budget;
     }
     const std::size_t first_copy = copies.size();
     const uint32_t first_job = block.dispatch.jobs;
@@ -244,7 +302,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
         const CaptureSource& s = sources[k];
         const std::optional<AddressHit> hit = CaptureSourceBuffer(ctx.state, s.address, s.size, CaptureRead::kCopy);
         if (!hit && s.optional) continue;
-        if (!hit || !log.Reserve(s.size, s.into)) {
+        if (!hit || !Reserve(ctx, log, s.size, s.into)) {
           entry.complete = false;
           break;
         }
@@ -255,22 +313,57 @@ bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBu
     if (!entry.complete) {
       copies.resize(first_copy);
       block.dispatch.jobs = first_job;
-      ctx.counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+      ++counts.not_captured;
     } else {
-      ctx.counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
-      ctx.counters.bytes_captured.fetch_add(total, std::memory_order_relaxed);
+      ++counts.captured;
+      counts.bytes += total;
     }
     captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
   if (!copies.empty() || block.dispatch.jobs != 0) {
     RecordCaptures(ctx, cb, copies, block.dispatch, recording.compute_pipeline);
   }
+  counts.AddTo(ctx.counters);
   return !captured.empty();
 }
+
+}  // namespace
+
+bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                        uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                        const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                        std::vector<uint32_t>& captured) {
+  captured.clear();
+  if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
+  try {
+    return CaptureBuildInputsOrThrow(ctx, cb, recording, info_count, infos, ranges, captured);
+  } catch (const std::bad_alloc&) {
+    uint64_t needing = 0;
+    for (uint32_t i = 0; i < info_count; ++i) needing += NeedsCapture(ctx.mode, infos[i]);
+    return CaptureDropped(ctx, needing, captured);
+  }
+}
+
 
 uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                                VkDeviceAddress address, VkAccelerationStructureKHR src) {
   if (ctx.mode == kCaptureOff || address == 0 || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return 0;
+  try {
+    return CaptureSerializedBlobOrThrow(ctx, cb, recording, address, src);
+  } catch (const std::bad_alloc&) {
+    // Nothing recorded (the copy is recorded last, after which nothing allocates): the blob is not captured.
+    std::vector<uint32_t> none;
+    CaptureDropped(ctx, 0, none);
+    ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
+    return 0;
+  }
+}
+
+namespace {
+
+uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                                      VkDeviceAddress address, VkAccelerationStructureKHR src) {
+  InjectBadAlloc(FailSite::kCaptureRecord);
   // The header (two UUIDs, then the serialized size, the deserialized size and the handle count): less than it
   // can never be hashed.
   constexpr VkDeviceSize kHeaderBytes = 2 * VK_UUID_SIZE + 3 * sizeof(uint64_t);
@@ -309,7 +402,7 @@ uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, Co
   const VkDeviceSize budget_left = log.bytes_captured < ctx.budget_bytes ? ctx.budget_bytes - log.bytes_captured : 0;
   const VkDeviceSize bytes = std::min(wanted, budget_left);
   CapturedBytes into;
-  if (bytes < kHeaderBytes || !log.Reserve(bytes, &into)) {
+  if (bytes < kHeaderBytes || !Reserve(ctx, log, bytes, &into)) {
     ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
     return 0;
   }
@@ -317,10 +410,13 @@ uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, Co
   thread_local std::vector<Copy> copies;
   copies.clear();
   copies.push_back(Copy{from->buffer, log.BufferOf(into), VkBufferCopy{address - from->base, into.offset, bytes}});
+  const uint32_t blob = log.AddBlob(into);  // before the copy is recorded: it may allocate
   RecordCopies(ctx, cb, copies);
   ctx.counters.blobs_captured.fetch_add(1, std::memory_order_relaxed);
   ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
-  return log.AddBlob(into);
+  return blob;
 }
+
+}  // namespace
 
 }  // namespace asval

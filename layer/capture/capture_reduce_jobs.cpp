@@ -110,7 +110,10 @@ bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry&
   }
   const VkDeviceSize index_bytes = indices ? indices->size : 0;
   CapturedBytes out;
-  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) return false;
+  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) {
+    state.capture_counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);  // no slab
+    return false;
+  }
   g.data = out;
   const VkDeviceSize bits = ReducedBitBytes(g.type, g.range.primitiveCount);
   if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, index_bytes, true};

@@ -1,5 +1,6 @@
 #include "capture_reducer.h"
 
+#include "failure_injection.h"
 #include "reduce_inputs.comp.h"
 
 namespace asval {
@@ -68,7 +69,9 @@ VkPipeline CaptureReducer::Pipeline() {
     info.stage.pName = "main";
     info.stage.pSpecializationInfo = &specialization;
     info.layout = layout_;
-    if (next_.CreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_) != VK_SUCCESS) {
+    // The test hook: as if vkCreateComputePipelines failed (the captures are then copied).
+    if (InjectedFailure(FailSite::kReducePipeline) ||
+        next_.CreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_) != VK_SUCCESS) {
       pipeline_ = VK_NULL_HANDLE;
     }
   });

@@ -1,6 +1,9 @@
 #include "capture_tracker.h"
 
 #include <algorithm>
+#include <new>
+
+#include "failure_injection.h"
 
 namespace asval {
 
@@ -31,6 +34,7 @@ VkFence CaptureTracker::TakeFence() {
   }
   VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VkFence fence = VK_NULL_HANDLE;
+  if (InjectedFailure(FailSite::kLayerFence)) return VK_NULL_HANDLE;  // the test hook: as if vkCreateFence failed
   if (!next_.CreateFence || next_.CreateFence(device_, &info, nullptr, &fence) != VK_SUCCESS) return VK_NULL_HANDLE;
   return fence;
 }
@@ -45,14 +49,29 @@ void CaptureTracker::Unreserve(const SubmissionCaptures& captures) {
   for (const std::shared_ptr<CaptureLog>& log : captures.logs) log->SubmissionEnded();
 }
 
+// With the processing lock held: a submission's captures that will never be read. Their activity and serialized
+// content are unknown (later updates of those structures are skipped and counted), and the checks they carried
+// for this submission are counted as not run.
+void CaptureTracker::Unread(SubmissionCaptures& captures) {
+  for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
+  // Serialized content never filled: the deserializations that read it stay unknown.
+  for (SerializeCapture& s : captures.serializes) s.content->status = SerializedContent::Status::kUnknown;
+  if (FailureCounters* failures = captures.failures) {
+    failures->submissions_captures_unread.fetch_add(1, std::memory_order_relaxed);
+    failures->capture_checks_unread.fetch_add(
+        captures.comparisons.size() + captures.instance_checks.size() + captures.indirect_checks.size(),
+        std::memory_order_relaxed);
+  }
+}
+
 void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence, SubmissionCaptures&& captures) {
   if (!app_fence && !layer_fence) {
-    // No fence to tell when the bytes are there: nothing is read (unknown).
+    // No fence to tell when the bytes are there (the submission had none, and the layer's own could not be made:
+    // TakeFence): nothing is read (unknown).
+    if (captures.failures) captures.failures->inserted_failures.fetch_add(1, std::memory_order_relaxed);
     {
       std::lock_guard<std::recursive_mutex> order(processing_);
-      for (const std::shared_ptr<BuildActivity>& node : captures.fills) node->MarkUnknown();
-      // Serialized content never filled: the deserializations that read it stay unknown.
-      for (SerializeCapture& s : captures.serializes) s.content->status = SerializedContent::Status::kUnknown;
+      Unread(captures);
     }
     Unreserve(captures);
     return;
@@ -63,7 +82,17 @@ void CaptureTracker::Track(VkQueue queue, VkFence app_fence, VkFence layer_fence
   p.app_fence = app_fence;
   p.fence = layer_fence;
   p.captures = std::move(captures);
-  pending_.push_back(std::move(p));
+  try {
+    pending_.push_back(std::move(p));
+  } catch (const std::bad_alloc&) {
+    // Not tracked: never read. (The layer's fence, if any, went down with the submission and is left to the
+    // driver: it cannot be destroyed while that submission may be pending.)
+    if (p.captures.failures) p.captures.failures->allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    std::lock_guard<std::recursive_mutex> order(processing_);
+    Unread(p.captures);
+    for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) log->SubmissionEnded();
+    return;
+  }
   pending_count_.fetch_add(1, std::memory_order_release);
   peak_pending_ = std::max(peak_pending_, pending_.size());
 }
@@ -94,8 +123,13 @@ void CaptureTracker::FenceRetired(VkFence app_fence) {
 void CaptureTracker::Retire(Pending& p) {
   for (const std::shared_ptr<CaptureLog>& log : p.captures.logs) log->SubmissionEnded();
   if (!p.fence) return;
-  next_.ResetFences(device_, 1, &p.fence);
-  free_fences_.push_back(p.fence);
+  try {
+    free_fences_.push_back(p.fence);
+    next_.ResetFences(device_, 1, &p.fence);
+  } catch (const std::bad_alloc&) {
+    next_.DestroyFence(device_, p.fence, nullptr);  // not kept for reuse: its submission completed
+    if (p.captures.failures) p.captures.failures->allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  }
   p.fence = VK_NULL_HANDLE;
 }
 
@@ -108,7 +142,7 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
   // Other queues' submissions are not waited for (they may run long); processing stops at the first of them
   // still pending, and goes on at the next wait or submission.
   std::vector<std::pair<VkQueue, std::size_t>> covered_until;  // per queue: entries [0, index) of it are covered
-  {
+  try {
     std::lock_guard<std::mutex> lock(mutex_);
     for (std::size_t k = 0; k < pending_.size() && covered.fence_count != 0; ++k) {
       const Pending& p = pending_[k];
@@ -122,6 +156,10 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       }
       if (!known) covered_until.emplace_back(p.queue, k + 1);
     }
+  } catch (const std::bad_alloc&) {
+    // The app's fences then cover nothing here: what completed is still processed (its own or the layer's fence
+    // polled), the rest at the next wait, submission or vkDestroyDevice.
+    covered_until.clear();
   }
   const auto fence_covers = [&](const Pending& p, std::size_t k) {
     for (const auto& [queue, until] : covered_until) {
@@ -153,7 +191,16 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
       current = std::move(p);
       pending_.pop_front();
     }
-    on_complete(current.captures);
+    try {
+      on_complete(current.captures);
+    } catch (const std::bad_alloc&) {
+      // The layer's allocation failed while this submission's captures were read (the builder's records, a
+      // finding): what was not read is unknown, counted; the app's wait returns as it would have.
+      if (current.captures.failures) {
+        current.captures.failures->allocation_failures.fetch_add(1, std::memory_order_relaxed);
+      }
+      Unread(current.captures);
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     Retire(current);
     // Pending until its findings are out: a wait hook that finds the tracker idle returns at once, and must not

@@ -75,6 +75,8 @@ class CaptureTracker {
     SubmissionCaptures captures;
   };
   void Retire(Pending& p);
+  // A submission's captures that will never be read: unknown, counted (with the processing lock held).
+  static void Unread(SubmissionCaptures& captures);
 
   const VkDevice device_;
   const DeviceDispatchTable& next_;

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <mutex>
+#include <new>
 #include <vector>
 
 #include "activity_rules.h"
@@ -27,21 +28,43 @@ void CollectActivityComparison(const HistoryStore& store, const AsOp& op, std::v
 
 }  // namespace
 
+// A host command's history checks not run: its operations could not be recorded (a lost batch), or the layer's
+// allocation failed while checking them. Counted as skipped for unknown history, once per command.
+void HostChecksSkipped(const CheckContext& ctx) {
+  ctx.state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
+  ctx.state.history.store.rules_skipped_unknown_history.fetch_add(1, std::memory_order_relaxed);
+}
+
 bool ValidateHostOps(const CheckContext& ctx, const OpBatch& batch, const char* function) {
-  if (!ctx.state.history_tracked || batch.empty()) return false;
+  if (!ctx.state.history_tracked || (batch.empty() && !batch.lost())) return false;
+  if (batch.lost()) {
+    ctx.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    HostChecksSkipped(ctx);
+    return false;
+  }
   HistoryFindings findings;
   std::vector<ActivityComparison> activity;
-  {
+  try {
     std::unique_lock<std::mutex> lock = ctx.state.history.store.Lock();
     const HistoryCheckSite site{Location(function), VK_NULL_HANDLE, false};
     for (const AsOp& op : batch.ops()) {
       CheckOpHistory(ctx.state, ctx.state.history.store, ctx.enabled_checks, batch, op, site, findings);
       if (ctx.Enabled(kCheckHistory)) CollectActivityComparison(ctx.state.history.store, op, activity);
     }
+  } catch (const std::bad_alloc&) {
+    // Half checked: nothing is reported (a finding list cut short says less than it seems), counted.
+    ctx.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    HostChecksSkipped(ctx);
+    return false;
   }
   bool skip = findings.ReportAll(ctx.reporter);  // no lock held: the app's callback may call Vulkan
   for (ActivityComparison& update : activity) {
-    update.after->Fill();  // this call's own record, not shared yet
+    try {
+      update.after->Fill();  // this call's own record, not shared yet
+    } catch (const std::bad_alloc&) {
+      update.after->MarkUnknown();  // judged as bytes not captured: skipped and counted
+      ctx.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    }
     skip |= CheckUpdateActivity(ctx, update);
   }
   return skip;
@@ -53,7 +76,36 @@ bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd) {
       ctx, HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges, cmd.host_capture, cmd.host_captured), cmd.function);
 }
 
+namespace {
+
+// The layer's own failures (failure_counters.h): what each made unknown, and that its checks were skipped and
+// counted. Said only when something failed.
+void ReportFailureSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const FailureCounters& f = state.failures();
+  if (!f.any()) return;
+  const auto n = [](const std::atomic<uint64_t>& counter) { return counter.load(std::memory_order_relaxed); };
+  reporter.Report(
+      Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("The layer's own failures: it could not allocate {} times ({} objects left untracked, {} "
+                  "command-buffer recordings lost, {} host commands' operations lost, {} submissions whose history "
+                  "could not be applied with {} operations left unchecked, {} structures' histories made unknown, "
+                  "{} commands' captures dropped); capture memory could not be had {} times (those infos were "
+                  "not captured); its own Vulkan objects (fence, reducing pipeline) could not be made {} times ({} "
+                  "submissions' captures never read, {} capture checks not run{}). What these left unknown was "
+                  "skipped and counted, never guessed; the app's calls went through with their own results.",
+                  n(f.allocation_failures), n(f.objects_untracked), n(f.recordings_lost), n(f.host_commands_lost),
+                  n(f.submissions_unknown), n(f.operations_unchecked), n(f.structures_made_unknown),
+                  n(f.capture_commands_dropped), n(f.capture_memory_failures), n(f.inserted_failures),
+                  n(f.submissions_captures_unread), n(f.capture_checks_unread),
+                  f.reduce_pipeline_failed.load(std::memory_order_relaxed)
+                      ? "; the reducing pipeline failed, so the captures were copied instead"
+                      : ""));
+}
+
+}  // namespace
+
 void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  ReportFailureSummary(state, reporter, device);
   const HistoryStore& store = state.history.store;
   const uint64_t skipped = store.rules_skipped_unknown_history.load(std::memory_order_relaxed);
   const CaptureCounters& capture = state.capture_counters;
@@ -98,7 +150,7 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
                   fmt::format("{} history checks were skipped because the history they need was unknown "
                               "({} structures got an unknown history: deserialized from bytes the layer could not "
                               "verify, copied from such a structure, written by a command buffer the layer did not "
-                              "see recorded, or operations the layer could not record). "
+                              "see recorded, or operations the layer could not record or apply). "
                               "{} operations were applied in execution order.",
                               skipped, store.structures_made_unknown.load(std::memory_order_relaxed),
                               store.ops_applied.load(std::memory_order_relaxed)));

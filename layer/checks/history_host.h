@@ -15,7 +15,9 @@ bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd);
 // Checks host operations (history_recorder.h builds them) against the histories now; reports. True when a
 // callback asked to skip the call.
 bool ValidateHostOps(const CheckContext& ctx, const OpBatch& batch, const char* function);
-// vkDestroyDevice: an info message (and JSON line) counting the history checks skipped for unknown history.
+// vkDestroyDevice: info messages (and JSON lines) counting the history checks skipped for unknown history, what the
+// capture could not capture, and the layer's own failures (allocations, capture memory, its own Vulkan objects:
+// failure_counters.h) with what they made unknown.
 void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device);
 
 }  // namespace asval

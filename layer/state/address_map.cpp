@@ -4,6 +4,7 @@
 #include <functional>
 #include <iterator>
 #include <mutex>
+#include <new>
 
 namespace asval {
 namespace {
@@ -41,17 +42,28 @@ bool DeviceAddressMap::Insert(VkDeviceAddress base, VkDeviceSize size, VkBuffer 
   if (buffer == VK_NULL_HANDLE || !last) return false;
 
   const Range range{base, *last};
-  ranges_.emplace(buffer, range);
-  // Split the end first or second does not matter: std::map insertions keep other iterators valid.
-  const auto first = SplitAt(base);
-  const auto stop = *last == kMaxAddress ? segments_.end() : SplitAt(*last + 1);
-  const Entry entry{buffer, range};
-  for (auto it = first; it != stop; ++it) {
-    EntryList& list = it->second;
-    const auto pos = std::lower_bound(list.begin(), list.end(), buffer, [](const Entry& e, VkBuffer b) {
-      return std::less<VkBuffer>{}(e.buffer, b);
-    });
-    list.insert(pos, entry);
+  try {
+    ranges_.emplace(buffer, range);
+    // Split the end first or second does not matter: std::map insertions keep other iterators valid.
+    const auto first = SplitAt(base);
+    const auto stop = *last == kMaxAddress ? segments_.end() : SplitAt(*last + 1);
+    const Entry entry{buffer, range};
+    for (auto it = first; it != stop; ++it) {
+      EntryList& list = it->second;
+      const auto pos = std::lower_bound(list.begin(), list.end(), buffer, [](const Entry& e, VkBuffer b) {
+        return std::less<VkBuffer>{}(e.buffer, b);
+      });
+      list.insert(pos, entry);
+    }
+  } catch (const std::bad_alloc&) {
+    // Half inserted: taken out of every list again (erasing allocates nothing), so that the map holds the buffer
+    // nowhere rather than in part of its range; boundaries split for it stay, separating equal lists (harmless).
+    for (auto& [at, list] : segments_) {
+      list.erase(std::remove_if(list.begin(), list.end(), [buffer](const Entry& e) { return e.buffer == buffer; }),
+                 list.end());
+    }
+    ranges_.erase(buffer);
+    throw;
   }
   // New boundaries separate lists that differ by `buffer`, so no merge is needed here.
   return true;

@@ -195,6 +195,8 @@ struct SubmissionCaptures {
   std::vector<std::shared_ptr<CaptureLog>> logs;
   // Each capture read once per submission (history_apply.cpp).
   std::map<std::pair<const CaptureLog*, uint32_t>, BuildActivity*> claimed;
+  // Where a submission whose captures cannot be read counts them (the device's; set by HistorySubmission).
+  FailureCounters* failures = nullptr;
   bool empty() const { return fills.empty() && serializes.empty() && deserializes.empty(); }
 };
 

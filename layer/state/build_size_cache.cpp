@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <mutex>
+#include <new>
 
 namespace asval {
 
@@ -199,7 +200,8 @@ const void* GeometryArrayOf(const BuildSignature& s) {
 void BuildSizeCache::RememberByArrays(ThreadTable& table, const BuildSignature& signature, const uint64_t* words,
                                       std::size_t count, const BuildSizes& sizes) const {
   ThreadTable::ByArrays& slot = table.ArraySlotFor(GeometryArrayOf(signature));
-  slot.cache_id = id_;
+  // Valid only once complete: an allocation failure below leaves the slot matching nothing.
+  slot.cache_id = 0;
   slot.geometries = GeometryArrayOf(signature);
   slot.counts = signature.counts;
   // Padded with zeros to MaxSignatureWords, the room MatchesWords reads; allocates only when this slot meets a
@@ -215,9 +217,11 @@ void BuildSizeCache::RememberByArrays(ThreadTable& table, const BuildSignature& 
     slot.raw_counts.resize(info.geometryCount);
     for (uint32_t j = 0; j < info.geometryCount; ++j) slot.raw_counts[j] = signature.Count(j);
   }
+  slot.cache_id = id_;
 }
 
-bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const {
+// An allocation failure (a long signature's per-thread room, a memo) is a miss: the caller asks the driver.
+bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, ThreadTable& table) const try {
   const ThreadTable::ByArrays& by_arrays = table.ArraySlotFor(GeometryArrayOf(signature));
   if (by_arrays.cache_id == id_ && by_arrays.geometries == GeometryArrayOf(signature) &&
       by_arrays.counts == signature.counts &&
@@ -253,6 +257,8 @@ bool BuildSizeCache::Find(const BuildSignature& signature, BuildSizes* out, Thre
   if (local) RememberLocally(table, hash, words.data(), words.count(), *out);
   RememberByArrays(table, signature, words.data(), words.count(), *out);
   return true;
+} catch (const std::bad_alloc&) {
+  return false;
 }
 
 std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature) const {
@@ -270,7 +276,11 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   std::vector<uint32_t> heap_counts;  // a miss may allocate; hits never come here
   uint32_t* counts = inline_counts;
   if (info.geometryCount > kInlineCounts) {
-    heap_counts.resize(info.geometryCount);
+    try {
+      heap_counts.resize(info.geometryCount);
+    } catch (const std::bad_alloc&) {
+      return std::nullopt;  // not asked: the rules that need the sizes skip and count
+    }
     counts = heap_counts.data();
   }
   for (uint32_t j = 0; j < info.geometryCount; ++j) counts[j] = signature.Count(j);
@@ -279,8 +289,17 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   query_(device_, signature.build_type, &info, counts, &answer);
   queries_.fetch_add(1, std::memory_order_relaxed);
   const BuildSizes sizes{answer.accelerationStructureSize, answer.buildScratchSize, answer.updateScratchSize};
+  try {
+    Remember(signature, sizes);
+  } catch (const std::bad_alloc&) {
+    // Not cached: the driver's answer still serves this call (and is asked again next time).
+  }
+  return sizes;
+}
+
+void BuildSizeCache::Remember(const BuildSignature& signature, const BuildSizes& sizes) const {
   const SignatureWords words(signature);
-  if (words.count() == 0) return sizes;  // not cacheable
+  if (words.count() == 0) return;  // not cacheable
 
   Entry entry;
   entry.sizes = sizes;
@@ -293,7 +312,6 @@ std::optional<BuildSizes> BuildSizeCache::Query(const BuildSignature& signature)
   // A colliding signature (same hash, other words) replaces the old entry: both stay correct, since Find
   // compares the words.
   shard.map.insert_or_assign(hash, std::move(entry));
-  return sizes;
 }
 
 std::size_t BuildSizeCache::size() const {

@@ -11,6 +11,8 @@ constexpr VkDeviceSize kAlignment = 16;
 bool CaptureLog::Reserve(VkDeviceSize size, CapturedBytes* where) {
   const VkDeviceSize offset = (used_in_last_slab_ + kAlignment - 1) & ~(kAlignment - 1);
   if (slabs.empty() || offset > slabs.back().size || size > slabs.back().size - offset) {
+    // Room first: a slab taken and then not kept would be lost to the pool until the device goes.
+    slabs.reserve(slabs.size() + 1);
     CaptureSlab slab;
     if (!owner_->Take(size, &slab)) return false;
     slabs.push_back(slab);

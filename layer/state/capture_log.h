@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "asval/builder/geometry_view.h"
+#include "failure_counters.h"
 #include "memory_range.h"
 
 namespace asval {
@@ -43,6 +44,9 @@ struct CaptureCounters {
   // infos_not_captured), and whether that was reported (once per device).
   std::atomic<uint64_t> infos_over_budget{0};
   std::atomic<bool> budget_reported{false};
+  // The layer's own failures, capture or not (failure_counters.h): kept here because every writer reaches
+  // DeviceState::capture_counters.
+  FailureCounters failures;
 };
 
 // One block of layer-owned memory that the device copies build inputs into and the host reads.

@@ -82,6 +82,7 @@ void OpBatch::Clear() {
   ops_.clear();
   geometries_.clear();
   applied_snapshots_.clear();
+  lost_ = false;
 }
 
 namespace {
@@ -175,6 +176,7 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
 }
 
 void OpBatch::AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary) {
+  if (secondary.lost_) lost_ = true;
   const uint32_t base = static_cast<uint32_t>(geometries_.size());
   geometries_.insert(geometries_.end(), secondary.geometries_.begin(), secondary.geometries_.end());
   for (AsOp op : secondary.ops_) {

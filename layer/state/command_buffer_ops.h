@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "memory_range.h"
@@ -171,6 +172,10 @@ class OpBatch {
   const std::vector<GeometryRecord>& geometries() const { return geometries_; }
   const GeometryRecord* GeometriesOf(const AsOp& op) const { return geometries_.data() + op.first_geometry; }
   bool empty() const { return ops_.empty(); }
+  // The operations could not all be recorded (an allocation failed: host commands, history_recorder.cpp): what
+  // the command does to structures is unknown. Set without allocating.
+  bool lost() const { return lost_; }
+  void MarkLost() { lost_ = true; }
 
   // Clears and keeps the capacity.
   void Clear();
@@ -178,6 +183,7 @@ class OpBatch {
     ops_.swap(other.ops_);
     geometries_.swap(other.geometries_);
     applied_snapshots_.swap(other.applied_snapshots_);
+    std::swap(lost_, other.lost_);
   }
 
   // A submitted batch remembers, per operation, the parameter snapshot it left in its destination when it was
@@ -210,6 +216,7 @@ class OpBatch {
   std::vector<AsOp> ops_;
   std::vector<GeometryRecord> geometries_;
   mutable std::vector<std::shared_ptr<const BuildSnapshot>> applied_snapshots_;
+  bool lost_ = false;
 };
 
 

@@ -68,8 +68,9 @@ class CommandBufferState {
   uint32_t NextOrdinal(OpCommand command) { return ++calls_[static_cast<std::size_t>(command)]; }
   // vkBeginCommandBuffer, vkResetCommandBuffer, vkResetCommandPool: empty recording, nothing published.
   void Reset();
-  // vkEndCommandBuffer: the recording becomes what submissions and primaries see.
-  void Publish();
+  // vkEndCommandBuffer: the recording becomes what submissions and primaries see. False when it became lost here
+  // (its snapshot could not be made: an allocation failure), a lost recording published instead.
+  bool Publish();
 
   // ---- any thread ----
   // The operations of the last completed recording; null when it has none (or the command buffer is being
@@ -102,9 +103,9 @@ class CommandBufferMap {
     if (std::shared_ptr<CommandBufferState> state = Find(cb)) state->Reset();
   }
   // vkEndCommandBuffer (after success): the recording becomes what submissions and primaries see.
-  void End(VkCommandBuffer cb) {
-    if (std::shared_ptr<CommandBufferState> state = Find(cb)) state->Publish();
-  }
+  void End(VkCommandBuffer cb);
+  // Where allocation failures are counted (DeviceState's: failure_counters.h); set once, at device creation.
+  void SetFailureCounters(FailureCounters* failures) { failures_ = failures; }
 
   // The state of a command buffer, or null when the layer never saw it allocated.
   std::shared_ptr<CommandBufferState> Find(VkCommandBuffer cb) const {
@@ -134,6 +135,9 @@ class CommandBufferMap {
   };
   std::shared_ptr<PoolState> PoolOf(VkCommandPool pool) const;
 
+  void CountUntracked(uint32_t count) const;
+
+  FailureCounters* failures_ = nullptr;
   ConcurrentMap<VkCommandBuffer, std::shared_ptr<CommandBufferState>, 6> buffers_;
   ConcurrentMap<VkCommandPool, std::shared_ptr<PoolState>> pools_;
   std::atomic<bool> any_protected_pool_{false};

@@ -11,6 +11,7 @@
 #include "build_size_cache.h"
 #include "command_buffers.h"
 #include "concurrent_map.h"
+#include "failure_injection.h"
 #include "history_state.h"
 #include "format_features.h"
 #include "host_mappings.h"
@@ -39,6 +40,12 @@ struct DeviceProperties {
 
 class DeviceState {
  public:
+  // A device is being created: the test hook ASVAL_TEST_FAIL is read now (failure_injection.h).
+  DeviceState() {
+    ArmFailureInjectionFromEnvironment();
+    command_buffers.SetFailureCounters(&capture_counters.failures);
+  }
+
   // Set once while vkCreateDevice runs, before any other thread can see the device.
   DeviceFeatures features;
   DeviceProperties properties;
@@ -72,8 +79,10 @@ class DeviceState {
   // Bumped when a buffer with ACCELERATION_STRUCTURE_STORAGE usage is bound, destroyed or has its memory freed: a
   // structure's storage may have changed (the snapshot above is taken again).
   ChangeStamp structure_storage_changes;
-  // Execution-time capture (layer/capture): what it captured, and could not.
+  // Execution-time capture (layer/capture): what it captured, and could not; and the layer's own failures
+  // (capture_counters.failures: failure_counters.h).
   mutable CaptureCounters capture_counters;
+  FailureCounters& failures() const { return capture_counters.failures; }
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};

@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <new>
 #include <optional>
 #include <string_view>
 
@@ -55,7 +56,11 @@ class FormatFeatureCache {
     if (std::optional<VkFormatFeatureFlags> cached = extension_formats_.find(format)) return cached;
     if (!KnownToHeaders(format)) return std::nullopt;
     const VkFormatFeatureFlags features = Query(format);
-    extension_formats_.insert_or_assign(format, features);
+    try {
+      extension_formats_.insert_or_assign(format, features);
+    } catch (const std::bad_alloc&) {
+      // Not cached: asked again next time.
+    }
     return features;
   }
 

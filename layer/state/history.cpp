@@ -85,9 +85,10 @@ uint32_t HistoryStore::Set(VkAccelerationStructureKHR as, AsHistory history, Tra
   }
   const uint64_t version = ++version_counter_;
   if (txn) {
-    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
-                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     txn->histories_.emplace_back(as, version, 0, false, AsHistory{});
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size() - 1)});
   }
   return Insert(as, std::move(history), version);
 }
@@ -100,9 +101,10 @@ void HistoryStore::SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHisto
                      old_span.end != history.span.end;
   if (moved) Unindex(as, old_span);
   if (txn) {
-    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
-                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     txn->histories_.emplace_back(as, version, r.version, true, std::move(r.history()));
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size() - 1)});
   }
   r.history() = std::move(history);
   r.version = version;
@@ -115,9 +117,10 @@ AsHistory& HistoryStore::RewriteInPlace(uint32_t record, VkAccelerationStructure
   const uint64_t version = ++version_counter_;
   AsHistory& h = r.history();
   if (txn) {
-    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
-                                               static_cast<uint32_t>(txn->histories_.size())});
+    txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     txn->histories_.emplace_back(as, version, r.version, true, std::move(h));  // leaves the span as it was
+    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kHistory,
+                                               static_cast<uint32_t>(txn->histories_.size() - 1)});
   }
   r.version = version;
   ResetForRewrite(h, build);
@@ -152,8 +155,9 @@ void HistoryStore::Forget(VkAccelerationStructureKHR as) {
 
 void HistoryStore::Push(Transaction* txn, Transaction::Kind kind, uint64_t blob_id) {
   if (!txn) return;
-  txn->entries_.push_back(Transaction::Entry{kind, static_cast<uint32_t>(txn->blobs_.size())});
+  txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
   txn->blobs_.push_back(blob_id);
+  txn->entries_.push_back(Transaction::Entry{kind, static_cast<uint32_t>(txn->blobs_.size() - 1)});
 }
 
 uint64_t HistoryStore::AddBlob(SerializedBlob blob, Transaction* txn) {
@@ -223,13 +227,15 @@ void HistoryStore::SetSlot(VkQueryPool pool, uint32_t query, const QuerySlot& sl
   const uint64_t version = ++version_counter_;
   auto it = slots_.find(key);
   if (txn) {
-    txn->entries_.push_back(Transaction::Entry{Transaction::Kind::kSlot, static_cast<uint32_t>(txn->slots_.size())});
+    txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     Transaction::SlotChange change{key, version, 0, std::nullopt};
     if (it != slots_.end()) {
       change.old_slot = it->second.slot;
       change.old_version = it->second.version;
     }
     txn->slots_.push_back(std::move(change));
+    txn->entries_.push_back(
+        Transaction::Entry{Transaction::Kind::kSlot, static_cast<uint32_t>(txn->slots_.size() - 1)});
   }
   slots_[key] = SlotRecord{slot, version};
   peak_query_slots_ = std::max(peak_query_slots_, slots_.size());

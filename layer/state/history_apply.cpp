@@ -1,7 +1,9 @@
 #include "history_apply.h"
 
 #include <cstring>
+#include <new>
 
+#include "failure_injection.h"
 #include "structure_memory.h"
 
 namespace asval {
@@ -182,10 +184,10 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     InstanceReferenceCheck check;
     check.log = log->shared_from_this();
     check.info = op.capture_info;
-    check.live = state.live_structure_addresses.Get(state.acceleration_structures,
-                                                    state.structure_storage_changes.Read(), [&](const auto& structure) {
-                                                      return StorageOfStructure(state, structure);
-                                                    });
+    check.live = state.live_structure_addresses.Get(
+        state.acceleration_structures, state.structure_storage_changes.Read(),
+        [&](const auto& structure) { return StorageOfStructure(state, structure); },
+        state.failures().structures_incomplete.load(std::memory_order_relaxed));
     if (state.instance_activity_snapshots) {
       check.activities.reserve(check.live->structures.size());
       for (const auto& structure : check.live->structures) {
@@ -449,15 +451,28 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
     if (!fresh) continue;
     fresh->history.kind = HistoryKind::kUnknown;
     fresh->history.unknown_reason = UnknownReason::kLostOperations;
-    store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
     store.Set(as, std::move(fresh->history), txn);
+    store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);  // once it is
   }
   // Any serialized bytes may have been overwritten.
   store.InvalidateAllBlobs(txn);
 }
 
+void MakeAllUnknownAfterFailure(const DeviceState& state, HistoryStore& store) {
+  FailureCounters& failures = state.failures();
+  const uint64_t before = store.structures_made_unknown.load(std::memory_order_relaxed);
+  try {
+    ApplyUnknownCommandBuffer(state, store, nullptr);
+  } catch (const std::bad_alloc&) {
+    failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  }
+  failures.structures_made_unknown.fetch_add(store.structures_made_unknown.load(std::memory_order_relaxed) - before,
+                                             std::memory_order_relaxed);
+}
+
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
              SubmissionCaptures* captures) {
+  InjectBadAlloc(FailSite::kApply);  // the test hook: as if this operation's first allocation failed
   switch (op.kind) {
     case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
     case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;

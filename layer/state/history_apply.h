@@ -18,12 +18,20 @@ std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, Vk
 // changes so that a skipped or failed submission can be rolled back. captures (may be null: host operations,
 // which capture nothing) collects what the submission's captured builds ask for once it completes: their
 // activity, and the updates to compare with their sources'.
+// Throws std::bad_alloc when the layer's allocation fails (the test hook's state_apply too); the callers catch it
+// where the state write began (HistorySubmission::Apply, the host commands' ApplyNow) and make every structure's
+// history unknown, counted (failure_counters.h).
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
              SubmissionCaptures* captures = nullptr);
 
 // A command buffer the layer never saw allocated, or whose operations it could not record, was submitted:
 // every structure that exists now gets an unknown history (undone with the submission, through txn).
 void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Transaction* txn);
+// After an allocation failure left what the layer recorded or applied incomplete: every structure's history made
+// unknown, not undoably (unknown is never wrong), counted in FailureCounters::structures_made_unknown. With the
+// store's lock held. It allocates too (the live structures' list, new records): a second failure leaves what it
+// reached unknown and the rest as it was (counted as one more allocation failure); never throws.
+void MakeAllUnknownAfterFailure(const DeviceState& state, HistoryStore& store);
 
 // Serialization sizes read back on the host (vkWriteAccelerationStructuresPropertiesKHR, or a query result
 // fetched with vkGetQueryPoolResults) for the structure's current contents.

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <new>
 
+#include "failure_injection.h"
 #include "history_apply.h"
 
 namespace asval {
@@ -30,14 +31,26 @@ LastRecordedBuild& ThisThreadsLastRecordedBuild() {
   return last;
 }
 
-// Runs an append; an allocation failure leaves the recording marked lost rather than silently incomplete.
+// Runs an append; an allocation failure leaves the recording marked lost rather than silently incomplete (its
+// submissions make every structure's history unknown), counted once per recording.
 template <typename F>
-void Guarded(CommandBufferState& cb, F&& append) {
+void Guarded(const DeviceState& state, CommandBufferState& cb, F&& append) {
   try {
+    InjectBadAlloc(FailSite::kRecording);
     append();
   } catch (const std::bad_alloc&) {
+    FailureCounters& failures = state.failures();
+    failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    if (!cb.recording_lost) failures.recordings_lost.fetch_add(1, std::memory_order_relaxed);
     cb.recording_lost = true;
   }
+}
+
+// A host command's operations could not be built: an empty batch marked lost (allocates nothing).
+OpBatch LostHostOps() {
+  OpBatch lost;
+  lost.MarkLost();
+  return lost;
 }
 
 OpOrigin DeviceOrigin(CommandBufferState& state, OpCommand command, VkCommandBuffer cb) {
@@ -93,10 +106,33 @@ void AttachBlobCapture(CommandBufferState& recording, uint32_t captured, AsOp& o
   op.capture_info = captured - 1;
 }
 
-void ApplyNow(DeviceState& state, const OpBatch& batch) {
+// A host command whose operations are lost (not built, not kept, or not applied): every structure's history is
+// unknown from now on. The allocation that failed is counted here (a lost batch was built where no counter is at
+// hand).
+void HostOpsLost(DeviceState& state) {
+  state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  state.failures().host_commands_lost.fetch_add(1, std::memory_order_relaxed);
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
-  for (const AsOp& op : batch.ops()) ApplyOp(state, state.history.store, batch, op, nullptr);
-  state.history.store.ops_applied.fetch_add(batch.ops().size(), std::memory_order_relaxed);
+  MakeAllUnknownAfterFailure(state, state.history.store);
+}
+
+void ApplyNow(DeviceState& state, const OpBatch& batch) {
+  if (batch.lost()) return HostOpsLost(state);
+  std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  std::size_t applied = 0;
+  try {
+    for (const AsOp& op : batch.ops()) {
+      ApplyOp(state, state.history.store, batch, op, nullptr);
+      ++applied;
+    }
+  } catch (const std::bad_alloc&) {
+    // Host operations are not undoable: what was applied stays, and everything is unknown from here on (the
+    // store's lock is held already).
+    state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    state.failures().host_commands_lost.fetch_add(1, std::memory_order_relaxed);
+    MakeAllUnknownAfterFailure(state, state.history.store);
+  }
+  state.history.store.ops_applied.fetch_add(applied, std::memory_order_relaxed);
 }
 
 }  // namespace
@@ -110,7 +146,7 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
   CommandBufferState* recording = RecordingBuild(state, cb, last ? *last : ThisThreadsLastRecordedBuild());
   if (!recording || !infos) return;
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
-  Guarded(*recording, [&] {
+  Guarded(state, *recording, [&] {
     recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured);
   });
 }
@@ -120,7 +156,7 @@ void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerat
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kCopy, info.src, info.dst, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopy, cb);
-  Guarded(*recording, [&] { recording->recording.Append(op); });
+  Guarded(state, *recording, [&] { recording->recording.Append(op); });
 }
 
 void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
@@ -129,9 +165,11 @@ void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyToMemory, cb);
-  op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);
   AttachBlobCapture(*recording, captured, op);
-  Guarded(*recording, [&] { recording->recording.Append(op); });
+  Guarded(state, *recording, [&] {
+    op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);  // may allocate (many buffers there)
+    recording->recording.Append(op);
+  });
 }
 
 void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
@@ -140,9 +178,11 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
   op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyMemoryTo, cb);
-  op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);
   AttachBlobCapture(*recording, captured, op);
-  Guarded(*recording, [&] { recording->recording.Append(op); });
+  Guarded(state, *recording, [&] {
+    op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);  // may allocate (many buffers there)
+    recording->recording.Append(op);
+  });
 }
 
 void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
@@ -151,7 +191,7 @@ void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t c
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording || !structures) return;
   const OpOrigin origin = DeviceOrigin(*recording, OpCommand::kCmdWriteProperties, cb);
-  Guarded(*recording, [&] {
+  Guarded(state, *recording, [&] {
     for (uint32_t i = 0; i < count; ++i) {
       AsOp op;
       op.kind = OpKind::kWriteProperties;
@@ -178,7 +218,7 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
   if (!recording || !secondaries) return;
   recording->compute_pipeline = VK_NULL_HANDLE;  // the primary's bound state is undefined after the secondaries
   for (uint32_t i = 0; i < count; ++i) {
-    Guarded(*recording, [&] { recording->secondaries.push_back(secondaries[i]); });
+    Guarded(state, *recording, [&] { recording->secondaries.push_back(secondaries[i]); });
     const std::shared_ptr<CommandBufferState> secondary = state.command_buffers.Find(secondaries[i]);
     if (!secondary) {
       recording->recording_lost = true;
@@ -188,7 +228,7 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
     const std::shared_ptr<const RecordedOps> ops = secondary->Executable();
     if (!ops) continue;
     if (ops->lost) recording->recording_lost = true;
-    Guarded(*recording, [&] {
+    Guarded(state, *recording, [&] {
       recording->recording.AppendExecuted(ops->batch, primary);
       recording->executed_capture_logs.insert(recording->executed_capture_logs.end(), ops->capture_logs.begin(),
                                               ops->capture_logs.end());
@@ -198,41 +238,57 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
 
 // ---- host commands -------------------------------------------------------------------------------------------
 
+// Host commands' operations are built in the hook, before the checks: an allocation failure there gives a lost
+// batch (LostHostOps), whose checks are skipped (ValidateHostOps) and whose application makes every structure's
+// history unknown (FinishHostOps).
 OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                      const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* capture,
-                     const uint32_t* captured) {
+                     const uint32_t* captured) try {
+  InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
   if (infos) batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges, capture, captured);
   return batch;
+} catch (const std::bad_alloc&) {
+  return LostHostOps();
 }
 
-OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info) {
+OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info) try {
+  InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
   AsOp op = CopyKindOp(OpKind::kCopy, info.src, info.dst, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopy);
   batch.Append(op);
   return batch;
+} catch (const std::bad_alloc&) {
+  return LostHostOps();
 }
 
-OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info) {
+OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info) try {
+  InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
   AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopyToMemory);
   op.memory.host_address = info.dst.hostAddress;
   batch.Append(op);
   return batch;
+} catch (const std::bad_alloc&) {
+  return LostHostOps();
 }
 
-OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
+OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info) try {
+  InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
   AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
   op.origin = HostOrigin(OpCommand::kHostCopyMemoryTo);
   op.memory.host_address = info.src.hostAddress;
   batch.Append(op);
   return batch;
+} catch (const std::bad_alloc&) {
+  return LostHostOps();
 }
 
-OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR* structures, VkQueryType type) {
+OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR* structures, VkQueryType type) try {
+  InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
   for (uint32_t i = 0; structures && i < count; ++i) {
     AsOp op;
@@ -244,22 +300,32 @@ OpBatch HostWritePropertiesOps(uint32_t count, const VkAccelerationStructureKHR*
     batch.Append(op);
   }
   return batch;
+} catch (const std::bad_alloc&) {
+  return LostHostOps();
 }
 
 void FinishHostOps(DeviceState& state, OpBatch batch, VkDeferredOperationKHR deferred, VkResult result,
                    std::shared_ptr<CaptureLog> capture) {
-  if (!state.history_tracked || batch.empty()) return;
+  if (!state.history_tracked || (batch.empty() && !batch.lost())) return;
   if (result == VK_SUCCESS || result == VK_OPERATION_NOT_DEFERRED_KHR) {
     ApplyNow(state, batch);
   } else if (result == VK_OPERATION_DEFERRED_KHR && deferred) {
-    auto pending = std::make_unique<DeferredHostOps>();
-    pending->batch = std::move(batch);
-    if (capture) pending->captures.push_back(std::move(capture));
-    std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
-    auto [it, inserted] = state.history.deferred.try_emplace(deferred, std::move(pending));
-    if (!inserted) {
-      it->second->batch.AppendExecuted(pending->batch, VK_NULL_HANDLE);
-      for (auto& held : pending->captures) it->second->captures.push_back(std::move(held));
+    if (batch.lost()) return HostOpsLost(state);  // the operation may complete at any time: unknown from now on
+    try {
+      auto pending = std::make_unique<DeferredHostOps>();
+      pending->batch = std::move(batch);
+      if (capture) pending->captures.push_back(std::move(capture));
+      std::lock_guard<std::mutex> lock(state.history.deferred_mutex);
+      auto [it, inserted] = state.history.deferred.try_emplace(deferred, std::move(pending));
+      if (!inserted) {
+        it->second->batch.AppendExecuted(pending->batch, VK_NULL_HANDLE);
+        for (auto& held : pending->captures) it->second->captures.push_back(std::move(held));
+      }
+    } catch (const std::bad_alloc&) {
+      // Not kept for its completion: what it does is unknown from now on (an entry already there for this
+      // deferred operation is still applied when it completes, and changes nothing unknown back to known wrongly:
+      // it only holds operations that do execute).
+      HostOpsLost(state);
     }
   }
   // Any other result: the command failed and changed nothing the layer can rely on.
@@ -274,7 +340,12 @@ void RecordHostSerializationSizes(DeviceState& state, uint32_t count, const VkAc
     uint64_t size = 0;
     std::memcpy(&size, static_cast<const unsigned char*>(data) + i * stride, sizeof(size));
     if (const AsHistory* h = store.Find(structures[i])) {
-      RecordSerializationSize(store, structures[i], h->generation, size);
+      try {
+        RecordSerializationSize(store, structures[i], h->generation, size);
+      } catch (const std::bad_alloc&) {
+        // Not attached: the size stays unknown (what needs it is skipped and counted).
+        state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+      }
     }
   }
 }
@@ -333,7 +404,11 @@ void RecordQueryResults(DeviceState& state, VkQueryPool pool, uint32_t first_que
     }
     // VK_QUERY_RESULT_PARTIAL_BIT values of unavailable queries are not final.
     if (!available) continue;
-    RecordSerializationSize(store, slot->as, slot->generation, value);
+    try {
+      RecordSerializationSize(store, slot->as, slot->generation, value);
+    } catch (const std::bad_alloc&) {
+      state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);  // the size stays unknown
+    }
   }
 }
 

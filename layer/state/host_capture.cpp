@@ -4,6 +4,7 @@
 #include <new>
 
 #include "capture_plan.h"
+#include "failure_injection.h"
 
 namespace asval {
 
@@ -25,11 +26,13 @@ class HeapSlabOwner final : public CaptureSlabOwner {
 
 }  // namespace
 
-HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                                   const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
-                                   VkDeviceSize budget_bytes, CaptureCounters& counters) {
+namespace {
+
+HostCapture CaptureOrThrow(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                           const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, VkDeviceSize budget_bytes,
+                           CaptureCounters& counters) {
   HostCapture capture;
-  if (!infos || !ranges) return capture;
+  InjectBadAlloc(FailSite::kCaptureRecord);
   std::vector<CaptureSource> sources;
   std::vector<CapturedGeometry> planned;
   for (uint32_t i = 0; i < info_count; ++i) {
@@ -76,6 +79,23 @@ HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStru
     capture.captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
   return capture;
+}
+
+}  // namespace
+
+HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                                   const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                                   VkDeviceSize budget_bytes, CaptureCounters& counters) {
+  if (!infos || !ranges) return HostCapture{};
+  try {
+    return CaptureOrThrow(info_count, infos, ranges, budget_bytes, counters);
+  } catch (const std::bad_alloc&) {
+    // Nothing captured: the call's updates are not judged on their inputs, and its builds leave no activity
+    // (skipped and counted where a later update needs it). The infos counted before the failure stay counted.
+    counters.failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    counters.failures.capture_commands_dropped.fetch_add(1, std::memory_order_relaxed);
+    return HostCapture{};
+  }
 }
 
 }  // namespace asval

@@ -73,13 +73,18 @@ class LiveStructureAddressCache {
   // The snapshot for now: the cached one while neither the structures nor the binding of any structure's storage
   // changed (`storage_stamp`: DeviceState::structure_storage_changes), else a new one, each structure's storage
   // judged by storage_of(const AccelerationStructureState&) -> StructureStorage.
+  // `incomplete`: some live structure has no shadow record (FailureCounters::structures_incomplete), so the
+  // snapshot is never complete.
   template <typename StorageOf>
   std::shared_ptr<const LiveStructureAddresses> Get(const StructureMap& structures, StampValue storage_stamp,
-                                                    StorageOf&& storage_of) const {
+                                                    StorageOf&& storage_of, bool incomplete = false) const {
     std::lock_guard<std::mutex> lock(mutex_);
     const StampValue stamp = structures.stamp();
-    if (cached_ && stamp == stamp_ && storage_stamp == storage_stamp_) return cached_;
+    if (cached_ && stamp == stamp_ && storage_stamp == storage_stamp_ && (!incomplete || !cached_->complete)) {
+      return cached_;
+    }
     auto fresh = std::make_shared<LiveStructureAddresses>();
+    if (incomplete) fresh->complete = false;
     std::vector<std::shared_ptr<const AccelerationStructureState>> live;
     for (auto& [handle, record] : structures.snapshot()) {
       if (!record || record->device_address == 0) {

@@ -1,11 +1,35 @@
 #include "state_tracker.h"
 
+#include <new>
+
+#include "failure_injection.h"
 #include "vk_dispatch_table.h"
 #include "vk_struct_chain.h"
 
 namespace asval {
 
-void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
+namespace {
+
+// A shadow record could not be made (the layer's allocation failed): the handle is left unknown to the layer, as
+// for an object created before it saw the device, so that the checks that need it skip and count; never a record
+// that says something else than what the driver did.
+void Untracked(const DeviceState& state) {
+  state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  state.failures().objects_untracked.fetch_add(1, std::memory_order_relaxed);
+}
+
+// The allocation failed while forgetting an object (a destruction, a free): what was forgotten stays forgotten;
+// the rest is said in the summary.
+void ForgetFailed(const DeviceState& state) {
+  state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+namespace {
+
+void AllocateMemoryRecord(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
+  InjectBadAlloc(FailSite::kObjectRecord);
   auto record = std::make_shared<MemoryState>();
   record->handle = memory;
   record->size = info.allocationSize;
@@ -25,9 +49,7 @@ void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, 
   state.memories.insert_or_assign(memory, std::move(record));
 }
 
-void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
-  state.memories.erase(memory);
-  state.host_mappings.Unmap(memory);  // freeing unmaps
+void ForgetBuffersOfMemory(DeviceState& state, VkDeviceMemory memory) {
   // Buffers bound to it keep their binding (it never goes away) but no longer have bytes or a usable device
   // address: their ranges leave the address map, so that a buffer later given the same addresses in another
   // allocation is the only one a lookup finds, and their records forget the memory's handle value.
@@ -45,11 +67,49 @@ void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
     state.buffers.insert_or_assign(handle, std::move(record));
   }
   if (storage) state.structure_storage_changes.Bump();
-  std::unique_lock<std::mutex> lock = state.history.store.Lock();
-  state.history.store.ForgetMemory(memory);
 }
 
-void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer, bool copyable) {
+}  // namespace
+
+void RecordAllocateMemory(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
+  try {
+    AllocateMemoryRecord(state, info, memory);
+  } catch (const std::bad_alloc&) {
+    state.memories.erase(memory);
+    Untracked(state);
+  }
+}
+
+void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
+  state.memories.erase(memory);
+  state.host_mappings.Unmap(memory);  // freeing unmaps
+  try {
+    ForgetBuffersOfMemory(state, memory);
+  } catch (const std::bad_alloc&) {
+    // Buffers bound to it could not all be rewritten: those left are forgotten (unknown) rather than kept bound to
+    // a handle value that a later allocation may reuse. Erasing allocates nothing.
+    ForgetFailed(state);
+    for (;;) {
+      VkBuffer stale = VK_NULL_HANDLE;
+      try {
+        const auto left = state.buffers.snapshot([memory](VkBuffer, const std::shared_ptr<const BufferState>& b) {
+          return b && b->bound && b->memory == memory;
+        });
+        if (!left.empty()) stale = left.front().first;
+      } catch (const std::bad_alloc&) {
+        break;
+      }
+      if (stale == VK_NULL_HANDLE) break;
+      state.failures().buffers_incomplete.store(true, std::memory_order_relaxed);
+      RecordDestroyBuffer(state, stale);
+    }
+  }
+  std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  state.history.store.ForgetMemory(memory);  // erases only
+}
+
+void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer, bool copyable) try {
+  InjectBadAlloc(FailSite::kObjectRecord);
   auto record = std::make_shared<BufferState>();
   record->handle = buffer;
   record->id = state.NextObjectId();
@@ -62,6 +122,10 @@ void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBu
   record->create_flags = info.flags;
   record->capture_source = copyable;
   state.buffers.insert_or_assign(buffer, std::move(record));
+} catch (const std::bad_alloc&) {
+  state.failures().buffers_incomplete.store(true, std::memory_order_relaxed);
+  state.buffers.erase(buffer);
+  Untracked(state);
 }
 
 void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer) {
@@ -78,7 +142,10 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
                             VkDeviceMemory memory, VkDeviceSize offset) {
   std::optional<std::shared_ptr<const BufferState>> old = state.buffers.find(buffer);
   if (!old || !*old) return;  // created before the layer saw the device: unknown, left alone
-  auto record = std::make_shared<BufferState>(**old);
+  VkDeviceAddress inserted = 0;
+  try {
+    InjectBadAlloc(FailSite::kObjectRecord);
+    auto record = std::make_shared<BufferState>(**old);
   record->bound = true;
   record->memory = memory;
   record->memory_offset = offset;
@@ -88,15 +155,25 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
   }
   if (record->device_address != 0) {
     state.buffer_addresses.Insert(record->device_address, record->size, buffer);
+    inserted = record->device_address;
   }
   const bool storage = (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
   state.buffers.insert_or_assign(buffer, std::move(record));
   if (storage) state.structure_storage_changes.Bump();
+  } catch (const std::bad_alloc&) {
+    // Kept unbound it would be reported as such: the buffer becomes unknown instead.
+    state.failures().buffers_incomplete.store(true, std::memory_order_relaxed);
+    if (inserted != 0) state.buffer_addresses.Erase(inserted, buffer);
+    state.buffers.erase(buffer);
+    state.structure_storage_changes.Bump();
+    Untracked(state);
+  }
 }
 
 void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device,
                                        const VkAccelerationStructureCreateInfoKHR& info,
-                                       VkAccelerationStructureKHR handle) {
+                                       VkAccelerationStructureKHR handle) try {
+  InjectBadAlloc(FailSite::kStructureRecord);
   auto record = std::make_shared<AccelerationStructureState>();
   record->handle = handle;
   record->buffer = info.buffer;
@@ -116,12 +193,22 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
     record->device_address = dispatch.GetAccelerationStructureDeviceAddressKHR(device, &address_info);
   }
   state.acceleration_structures.insert_or_assign(handle, std::move(record));
+} catch (const std::bad_alloc&) {
+  // Unknown to the layer: its checks skip and count (a handle that is not a live structure the layer knows), and
+  // the histories never record it (history_apply.cpp: Fresh).
+  state.failures().structures_incomplete.store(true, std::memory_order_relaxed);
+  state.acceleration_structures.erase(handle);
+  Untracked(state);
 }
 
 void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
   state.acceleration_structures.erase(handle);
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
-  state.history.store.Forget(handle);
+  try {
+    state.history.store.Forget(handle);  // the record is out of the index before anything is allocated
+  } catch (const std::bad_alloc&) {
+    ForgetFailed(state);
+  }
 }
 
 void RecordMapMemory(DeviceState& state, VkDeviceMemory memory, VkDeviceSize offset, VkDeviceSize size,
@@ -132,13 +219,24 @@ void RecordMapMemory(DeviceState& state, VkDeviceMemory memory, VkDeviceSize off
     if (!record || !*record || (*record)->size < offset) return;  // extent unknown: not recorded
     bytes = (*record)->size - offset;
   }
-  state.host_mappings.Map(memory, offset, bytes, host_address);
+  try {
+    InjectBadAlloc(FailSite::kObjectRecord);
+    state.host_mappings.Map(memory, offset, bytes, host_address);
+  } catch (const std::bad_alloc&) {
+    // Not recorded: a host pointer into it is then in no mapping the layer knows, and is not judged.
+    state.host_mappings.Unmap(memory);
+    Untracked(state);
+  }
 }
 
 void RecordUnmapMemory(DeviceState& state, VkDeviceMemory memory) { state.host_mappings.Unmap(memory); }
 
-void RecordCreateQueryPool(DeviceState& state, const VkQueryPoolCreateInfo& info, VkQueryPool pool) {
+void RecordCreateQueryPool(DeviceState& state, const VkQueryPoolCreateInfo& info, VkQueryPool pool) try {
+  InjectBadAlloc(FailSite::kObjectRecord);
   state.history.query_pools.insert_or_assign(pool, QueryPoolState{info.queryType, info.queryCount});
+} catch (const std::bad_alloc&) {
+  state.history.query_pools.erase(pool);  // unknown: its queries' rules skip, its results are not attached
+  Untracked(state);
 }
 
 void RecordDestroyQueryPool(DeviceState& state, VkQueryPool pool) {

@@ -19,7 +19,11 @@ HistorySubmission::~HistorySubmission() {
   if (store_lock_.owns_lock()) store_lock_.unlock();
   txn_->Clear();
   store_lock_ = state_.history.store.Lock();
-  state_.history.store.ReturnTransaction(std::move(txn_));
+  try {
+    state_.history.store.ReturnTransaction(std::move(txn_));
+  } catch (const std::bad_alloc&) {
+    // Not kept as a spare (freed): nothing is lost but its capacity.
+  }
   store_lock_.unlock();
 }
 
@@ -29,11 +33,31 @@ void HistorySubmission::Begin() {
   if (!txn_) txn_ = state_.history.store.TakeTransaction();
 }
 
+void HistorySubmission::ApplyFailed(std::size_t unchecked) {
+  FailureCounters& failures = state_.failures();
+  failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  failures.submissions_unknown.fetch_add(1, std::memory_order_relaxed);
+  failures.operations_unchecked.fetch_add(unchecked, std::memory_order_relaxed);
+  // Begin may have failed after taking the locks (they allocate nothing) but before the undo log.
+  if (!order_lock_.owns_lock()) order_lock_ = std::unique_lock<std::recursive_mutex>(state_.history.submission_order);
+  if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
+  MakeAllUnknownAfterFailure(state_, state_.history.store);
+}
+
 void HistorySubmission::Undo() {
   captures_ = SubmissionCaptures{};  // nothing executes: nothing to read
+  captures_.failures = &state_.failures();
   if (!txn_ || txn_->empty()) return;
   if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
-  state_.history.store.Undo(*txn_);
+  try {
+    state_.history.store.Undo(*txn_);
+  } catch (const std::bad_alloc&) {
+    // Half undone: the histories may hold changes of a submission that did not happen. Unknown instead.
+    FailureCounters& failures = state_.failures();
+    failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    failures.submissions_unknown.fetch_add(1, std::memory_order_relaxed);
+    MakeAllUnknownAfterFailure(state_, state_.history.store);
+  }
   store_lock_.unlock();
 }
 

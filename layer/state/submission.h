@@ -21,6 +21,7 @@
 #include <vulkan/vulkan.h>
 
 #include <mutex>
+#include <new>
 
 #include "device_state.h"
 #include "history_apply.h"
@@ -29,33 +30,44 @@ namespace asval {
 
 class HistorySubmission {
  public:
-  explicit HistorySubmission(DeviceState& state) : state_(state) {}
+  explicit HistorySubmission(DeviceState& state) : state_(state) { captures_.failures = &state.failures(); }
   HistorySubmission(const HistorySubmission&) = delete;
   HistorySubmission& operator=(const HistorySubmission&) = delete;
   ~HistorySubmission();
 
   // Applies the operations of one submitted command buffer, in recording order, calling
-  // check(const HistoryStore&, const OpBatch&, const AsOp&) before each.
+  // check(const HistoryStore&, const OpBatch&, const AsOp&) before each. An allocation failure (the layer's, in
+  // the apply or in a check) stops this command buffer there: every structure's history is made unknown from that
+  // point on (not undone with the submission: unknown is never wrong), and the operations whose checks did not run
+  // are counted (ApplyFailed). Nothing is thrown to the hook.
   template <typename Check>
   void Apply(VkCommandBuffer cb, Check&& check) {
     if (!state_.history_tracked) return;
     std::shared_ptr<const RecordedOps> ops;
     if (!Lookup(cb, &ops)) return;  // most submitted command buffers build nothing: no lock
-    Begin();
-    HistoryStore& store = state_.history.store;
-    if (!ops || ops->lost) {
-      // A command buffer the layer never saw allocated, or whose operations it could not record.
-      ApplyUnknownCommandBuffer(state_, store, txn_.get());
-      return;
+    std::size_t total = 0, checked = 0, applied = 0;
+    try {
+      Begin();
+      HistoryStore& store = state_.history.store;
+      if (!ops || ops->lost) {
+        // A command buffer the layer never saw allocated, or whose operations it could not record.
+        ApplyUnknownCommandBuffer(state_, store, txn_.get());
+        return;
+      }
+      const OpBatch& batch = ops->batch;
+      total = batch.ops().size();
+      txn_->ReserveMore(total);  // one entry per written structure (clobbers are rare)
+      for (const AsOp& op : batch.ops()) {
+        check(static_cast<const HistoryStore&>(store), batch, op);
+        ++checked;
+        ApplyOp(state_, store, batch, op, txn_.get(), &captures_);
+        ++applied;
+      }
+    } catch (const std::bad_alloc&) {
+      ApplyFailed(total - checked);
     }
-    const OpBatch& batch = ops->batch;
-    txn_->ReserveMore(batch.ops().size());  // one entry per written structure (clobbers are rare)
-    for (const AsOp& op : batch.ops()) {
-      check(static_cast<const HistoryStore&>(store), batch, op);
-      ApplyOp(state_, store, batch, op, txn_.get(), &captures_);
-    }
-    ops_applied_ += batch.ops().size();
-    store.ops_applied.fetch_add(batch.ops().size(), std::memory_order_relaxed);
+    ops_applied_ += applied;
+    state_.history.store.ops_applied.fetch_add(applied, std::memory_order_relaxed);
   }
   // Releases the store's lock (the order lock stays held until destruction).
   void EndApply() {
@@ -72,6 +84,8 @@ class HistorySubmission {
   // False when the command buffer does nothing to structures; *ops null when what it does is unknown.
   bool Lookup(VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) const;
   void Begin();
+  // An allocation failed while applying: every structure unknown from here on, counted.
+  void ApplyFailed(std::size_t unchecked);
 
   DeviceState& state_;
   // Declared before store_lock_: released after it.
