@@ -13,7 +13,8 @@ namespace asval {
 // A buffer of this device whose device-address range holds all of [address, address + size) (size 0: just
 // `address`) and that was created with every bit of `usage` (0: any usage). Only bound buffers are in the
 // address map, so a hit is bound to memory. Clean path: one address-map lookup, plus one buffer-state lookup
-// per candidate when usage is asked for.
+// per candidate when usage is asked for. While some buffer's shadow record could not be made (the layer's
+// allocation failed), an address not found is unknown: a hit naming no buffer, the skip counted.
 std::optional<AddressHit> FindBufferHolding(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size,
                                             VkBufferUsageFlags usage);
 

@@ -91,7 +91,12 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
   const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
   bool skip = false;
   const AccelerationStructureState* dst = r.dst;
-  if (!dst) {
+  // A handle the layer does not know may be a structure whose shadow record its allocation failed to make
+  // (failure_counters.h): then unknown, skipped and counted, not reported.
+  const bool structures_incomplete = ctx.state.failures().structures_incomplete.load(std::memory_order_relaxed);
+  if (!dst && info.dstAccelerationStructure != VK_NULL_HANDLE && structures_incomplete) {
+    CountUnknownState(ctx);
+  } else if (!dst) {
     skip |= ReportInvalidDestination(ctx, cmd, i);
   } else {
     skip |= ValidateDestinationType(ctx, cmd, i, *dst);
@@ -99,7 +104,9 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
   }
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
     const AccelerationStructureState* src = r.src;
-    if (!src) {
+    if (!src && structures_incomplete) {
+      CountUnknownState(ctx);
+    } else if (!src) {
       skip |= ReportInvalidSource(ctx, cmd, i);
     } else if (!cmd.is_host() && info.mode == VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR) {
       skip |= ValidateBound(ctx, cmd, i, *src, "pInfos-03708", "srcAccelerationStructure");
