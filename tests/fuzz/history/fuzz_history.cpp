@@ -6,6 +6,7 @@
 // compared with the reference model (history_model.h); any difference aborts with the step and the fact that
 // differs. The history rules (CheckOpHistory) run before each submitted operation, as in vkQueueSubmit, for
 // sanitizer coverage of the rules on every state the sequence reaches.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -297,7 +298,8 @@ class Harness {
         VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
         copy.src = Handle(op.src);
         copy.dst = Handle(op.dst);
-        copy.mode = r.Bit() ? VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR : VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+        op.compact = r.Bit();
+        copy.mode = op.compact ? VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR : VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
         RecordCmdCopy(state_, cb, copy);
         m.ops.push_back(op);
         break;
@@ -364,7 +366,90 @@ class Harness {
     }
   }
 
-  // The checks of vkQueueSubmit, without a reporter: findings are collected and dropped.
+  // The findings the history rules must give for `op` before it executes, from the model (update_rules.h; the
+  // copies family's dst-03561 never fires here: every destination has room for the sizes read back).
+  std::vector<std::string> Predict(const ModelOp& op) const {
+    std::vector<std::string> out;
+    const auto readable = [&](uint32_t as) -> const ModelHistory* {
+      const ModelStructure& s = model_.structures[as];
+      if (!s.live || s.history.kind == ModelKind::kUnknown) return nullptr;  // skipped and counted
+      return &s.history;
+    };
+    switch (op.kind) {
+      case ModelOp::kBuild: {
+        if (!op.update) break;
+        const ModelHistory* h = readable(op.src);
+        if (!h) break;
+        const std::string vuid = std::string("VUID-") +
+                                 (op.indirect ? "vkCmdBuildAccelerationStructuresIndirectKHR-"
+                                              : "vkCmdBuildAccelerationStructuresKHR-");
+        if (h->clobbered) out.push_back(kClobberedId);
+        if (h->kind == ModelKind::kNeverBuilt) {
+          out.push_back(vuid + "pInfos-03667");
+          break;
+        }
+        if (op.unreadable) break;
+        const ModelParams& s = h->params;
+        const ModelParams& u = op.params;
+        if (!(s.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR)) out.push_back(vuid + "pInfos-03667");
+        if (s.geometries.size() != u.geometries.size()) out.push_back(vuid + "pInfos-03758");
+        if (s.flags != u.flags) out.push_back(vuid + "pInfos-03759");
+        if (s.type != u.type) out.push_back(vuid + "pInfos-03760");
+        for (size_t j = 0; j < std::min(s.geometries.size(), u.geometries.size()); ++j) {
+          const ModelGeometry& b = s.geometries[j];
+          const ModelGeometry& g = u.geometries[j];
+          if (g.type != b.type) {
+            out.push_back(vuid + "pInfos-03761");
+            continue;
+          }
+          if (g.flags != b.flags) out.push_back(vuid + "pInfos-03762");
+          if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+            if (g.vertex_format != b.vertex_format) out.push_back(vuid + "pInfos-03763");
+            if (g.max_vertex != b.max_vertex) out.push_back(vuid + "pInfos-03764");
+            if (g.index_type != b.index_type) out.push_back(vuid + "pInfos-03765");
+            if (!b.has_transform && g.has_transform) out.push_back(vuid + "pInfos-03766");
+            if (b.has_transform && !g.has_transform) out.push_back(vuid + "pInfos-03767");
+          }
+          if (g.count_known && b.count_known && g.primitive_count != b.primitive_count) {
+            out.push_back(vuid + "primitiveCount-03769");
+          }
+        }
+        break;
+      }
+      case ModelOp::kCopy:
+      case ModelOp::kSerializeDevice: {
+        const ModelHistory* h = readable(op.src);
+        if (!h) break;
+        if (h->clobbered) out.push_back(kClobberedId);
+        if (h->kind == ModelKind::kNeverBuilt) {
+          out.push_back(op.kind == ModelOp::kCopy ? "VUID-VkCopyAccelerationStructureInfoKHR-src-04963"
+                                                  : "VUID-VkCopyAccelerationStructureToMemoryInfoKHR-src-04959");
+        } else if (op.kind == ModelOp::kCopy && op.compact && h->kind == ModelKind::kBuilt &&
+                   !(h->params.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
+          out.push_back("VUID-VkCopyAccelerationStructureInfoKHR-src-03411");
+        }
+        break;
+      }
+      case ModelOp::kWriteProperties: {
+        const ModelHistory* h = readable(op.dst);
+        if (!h) break;
+        if (h->kind == ModelKind::kNeverBuilt) {
+          out.push_back("VUID-vkCmdWriteAccelerationStructuresPropertiesKHR-pAccelerationStructures-04964");
+        } else if (op.query_type == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR &&
+                   !(h->params.flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
+          out.push_back("VUID-vkCmdWriteAccelerationStructuresPropertiesKHR-accelerationStructures-03431");
+        }
+        break;
+      }
+      default:
+        break;
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  // vkQueueSubmit's history path: before each operation the rules run (their findings collected, not reported,
+  // and compared with the model's prediction), then the operation is applied to the store and to the model.
   void Submit(Reader& r) {
     uint32_t order[3];
     const uint32_t count = 1 + r.Below(3);
@@ -372,25 +457,46 @@ class Harness {
     const uint8_t outcome = r.Below(4);  // 0: the driver rejects it, 1: and a host operation completes meanwhile
     const Model before = model_;
     model_.BeginSubmission();
-    HistoryFindings findings;
     {
       HistorySubmission submission(state_);
       for (uint32_t k = 0; k < count; ++k) {
         const VkCommandBuffer cb = CommandBuffer(order[k]);
         const HistoryCheckSite site{Location("vkQueueSubmit").Field("pSubmits", 0).Field("pCommandBuffers", k), cb,
                                     true};
+        const bool known = order[k] < kCommandBuffers && cbs_[order[k]].allocated;
+        const std::vector<ModelOp>* ops = known && cbs_[order[k]].published && !cbs_[order[k]].published_lost
+                                              ? &cbs_[order[k]].published_ops
+                                              : nullptr;
+        size_t next = 0;
         submission.Apply(cb, [&](const HistoryStore& store, const OpBatch& batch, const AsOp& op) {
-          CheckOpHistory(state_, store, kAllChecks, batch, op, site, findings);
-        });
-        if (order[k] == kCommandBuffers || !cbs_[order[k]].allocated) {
-          model_.ApplyLost();
-        } else if (cbs_[order[k]].published) {
-          const CommandBufferModel& m = cbs_[order[k]];
-          if (m.published_lost) {
-            model_.ApplyLost();
-          } else {
-            for (const ModelOp& op : m.published_ops) model_.Apply(op, host_);
+          if (!ops || next >= ops->size() || batch.ops().size() != ops->size()) {
+            Mismatch(step_, "command buffer " + std::to_string(order[k]) + " submits " +
+                                std::to_string(batch.ops().size()) + " recorded operations, model: " +
+                                std::to_string(ops ? ops->size() : 0));
           }
+          HistoryFindings findings;
+          CheckOpHistory(state_, store, kAllChecks, batch, op, site, findings);
+          std::vector<std::string> found;
+          for (const HistoryFinding& f : findings.list()) found.push_back(f.vuid);
+          std::sort(found.begin(), found.end());
+          const ModelOp& mop = (*ops)[next++];
+          const std::vector<std::string> expected = Predict(mop);
+          if (found != expected) {
+            std::string text;
+            for (const std::string& v : found) text += " " + v;
+            text += " | model:";
+            for (const std::string& v : expected) text += " " + v;
+            Mismatch(step_, "findings of operation " + std::to_string(next - 1) + " (kind " +
+                                std::to_string(mop.kind) + ") of command buffer " + std::to_string(order[k]) +
+                                ":" + text);
+          }
+          model_.Apply(mop, host_);
+        });
+        if (!known || (cbs_[order[k]].published && cbs_[order[k]].published_lost)) {
+          model_.ApplyLost();
+        } else if (ops && next != ops->size()) {
+          Mismatch(step_, "command buffer " + std::to_string(order[k]) + ": " + std::to_string(next) +
+                              " operations applied, model: " + std::to_string(ops->size()));
         }
       }
       submission.EndApply();

@@ -59,6 +59,7 @@ struct ModelOp {
   uint32_t src = 0, dst = 0;  // handle indices
   bool update = false;
   bool indirect = false;
+  bool compact = false;       // kCopy: VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR
   bool unreadable = false;
   ModelParams params;
   // kSerializeDevice: the memory bytes [begin, end) the destination reaches (end: the buffer's end).
