@@ -6,7 +6,14 @@ set -euo pipefail
 
 # Packages of the system's own suite.
 BASE_PKGS=(g++ cmake ninja-build pkg-config python3 libvulkan-dev vulkan-tools glslang-tools
-           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev nlohmann-json3-dev valgrind)
+           libspdlog-dev vulkan-validationlayers libpng-dev libxxhash-dev nlohmann-json3-dev valgrind clang)
+# The libFuzzer runtime for the fuzz build (scripts/test.sh) is packaged per LLVM version: that of the suite's
+# default clang (Debian 12: 14, Debian 13: 19).
+. /etc/os-release 2>/dev/null || true
+case "${ID:-}:${VERSION_ID:-}" in
+  debian:12) BASE_PKGS+=(libclang-rt-14-dev) ;;
+  debian:13) BASE_PKGS+=(libclang-rt-19-dev) ;;
+esac
 # Packages that need a newer version than Debian 12 has: lavapipe with ray tracing (bookworm's Mesa 22.3 has none)
 # and Catch2 3 (bookworm has only Catch2 2). Debian 13 has both in main; Debian 12 takes them from
 # bookworm-backports.
@@ -45,7 +52,6 @@ missing=$(missing_pkgs "${BASE_PKGS[@]}")
 missing_newer=$(too_old)
 [ -z "$missing" ] && [ -z "$missing_newer" ] && exit 0
 
-. /etc/os-release 2>/dev/null || true
 if [ "${ID:-}" != debian ] || { [ "${VERSION_ID:-}" != 12 ] && [ "${VERSION_ID:-}" != 13 ]; }; then
   manual_help "this is not Debian 12 or 13 (found ${PRETTY_NAME:-unknown}); automatic install is only for those."
 fi
