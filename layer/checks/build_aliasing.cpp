@@ -168,7 +168,7 @@ void CollectSpans(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, 
   // Host builds: the structures the instances reference are read by this command (dstAccelerationStructure-03706).
   for (uint32_t j = 0; j < info.geometryCount; ++j) {
     w.references.clear();
-    if (!CollectInstanceReferences(cmd, i, j, w.references)) continue;
+    if (!CollectInstanceReferences(ctx.state, cmd, i, j, w.references)) continue;
     for (uint64_t reference : w.references) {
       const auto handle = reinterpret_cast<VkAccelerationStructureKHR>(reference);
       // The whole structure: which of its bytes the build reads is the driver's business.
@@ -300,7 +300,7 @@ bool ValidateUpdateAliasing(const CheckContext& ctx, const BuildCommand& cmd, ui
 // None-03407 (host builds): no instance references another info's destination.
 [[gnu::cold, gnu::noinline]] bool ReportReferencedDestination(const CheckContext& ctx, const BuildCommand& cmd,
                                                               uint32_t k, uint32_t j, uint32_t i, uint64_t reference) {
-  const uint32_t instance = FirstInstanceReferencing(cmd, k, j, reference);
+  const uint32_t instance = FirstInstanceReferencing(ctx.state, cmd, k, j, reference);
   return ReportBuild(ctx, cmd, k, "None-03407",
                      [&](std::string&) {
                        return GeometryLocation(cmd, k, j).Field("geometry").Field("instances").Field("data").Field(
@@ -322,7 +322,7 @@ bool ValidateReferencedDestinations(const CheckContext& ctx, const BuildCommand&
     if (cmd.infos[k].type != VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) continue;
     for (uint32_t j = 0; j < cmd.infos[k].geometryCount; ++j) {
       w.references.clear();
-      if (!CollectInstanceReferences(cmd, k, j, w.references)) continue;
+      if (!CollectInstanceReferences(ctx.state, cmd, k, j, w.references)) continue;
       for (uint64_t reference : w.references) {
         auto it = std::lower_bound(w.destinations.begin(), w.destinations.end(), std::make_pair(reference, 0u));
         for (; it != w.destinations.end() && it->first == reference; ++it) {

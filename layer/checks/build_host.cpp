@@ -36,9 +36,10 @@ Location PlaceLocation(const BuildCommand& cmd, const StructurePlace& place) {
 }
 
 // "(instance k) references " for an instance's structure: the first instance that does (found when reporting).
-std::string PlacePrefix(const BuildCommand& cmd, const StructurePlace& place, VkAccelerationStructureKHR handle) {
+std::string PlacePrefix(const DeviceState& state, const BuildCommand& cmd, const StructurePlace& place,
+                        VkAccelerationStructureKHR handle) {
   if (place.member) return "";
-  const uint32_t k = FirstInstanceReferencing(cmd, place.info, place.geometry, reinterpret_cast<uint64_t>(handle));
+  const uint32_t k = FirstInstanceReferencing(state, cmd, place.info, place.geometry, reinterpret_cast<uint64_t>(handle));
   return fmt::format("(instance {}) references ", k);
 }
 
@@ -51,7 +52,7 @@ std::string PlacePrefix(const BuildCommand& cmd, const StructurePlace& place, Vk
   return ReportBuild(ctx, cmd, place.info, rule, [&](std::string&) { return PlaceLocation(cmd, place); },
                      "{}VkAccelerationStructureKHR 0x{:x}, whose VkBuffer 0x{:x} is bound to VkDeviceMemory 0x{:x} "
                      "{}.",
-                     PlacePrefix(cmd, place, memory.structure->handle),
+                     PlacePrefix(ctx.state, cmd, place, memory.structure->handle),
                      reinterpret_cast<uint64_t>(memory.structure->handle),
                      reinterpret_cast<uint64_t>(memory.buffer->handle), reinterpret_cast<uint64_t>(record.handle),
                      host_visible_rule
@@ -142,7 +143,7 @@ bool ValidateHostScratch(const CheckContext& ctx, const BuildCommand& cmd, uint3
 bool ValidateInstanceReferences(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                                 std::vector<uint64_t>& references) {
   references.clear();
-  if (!CollectInstanceReferences(cmd, i, j, references)) return false;
+  if (!CollectInstanceReferences(ctx.state, cmd, i, j, references)) return false;
   bool skip = false;
   const StructurePlace place{i, nullptr, j};
   for (uint64_t reference : references) {
@@ -154,7 +155,7 @@ bool ValidateInstanceReferences(const CheckContext& ctx, const BuildCommand& cmd
     skip |= ReportBuild(ctx, cmd, i, "pInfos-03779", [&](std::string&) { return PlaceLocation(cmd, place); },
                         "(instance {}) has accelerationStructureReference 0x{:x}, which is not a live "
                         "VkAccelerationStructureKHR of this device.",
-                        FirstInstanceReferencing(cmd, i, j, reference), reference);
+                        FirstInstanceReferencing(ctx.state, cmd, i, j, reference), reference);
   }
   return skip;
 }

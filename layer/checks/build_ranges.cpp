@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "build_report.h"
+#include "host_reads.h"
 #include "rule_judge.h"
 #include "vertex_format_alignment.h"
 #include "vk_enum_string.h"
@@ -117,13 +118,19 @@ bool ReportRange(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, u
   return false;
 }
 
-// maxVertex-10774 for a host build: the indices are in host memory now, so the largest can be read.
+// maxVertex-10774 for a host build: the indices are in host memory now, so the largest can be read (where they may
+// be read: host_reads.h; else the rule is skipped and counted).
 bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i, uint32_t j,
                                 const VkAccelerationStructureGeometryTrianglesDataKHR& tri,
                                 const VkAccelerationStructureBuildRangeInfoKHR& range, int index_size) {
   if (range.primitiveCount == 0 || tri.indexData.hostAddress == nullptr) return false;
+  const uint64_t count = uint64_t{range.primitiveCount} * 3;
+  if (!HostBytesReadable(ctx.state, tri.indexData.hostAddress, range.primitiveOffset + count * index_size)) {
+    CountUnknownState(ctx);
+    return false;
+  }
   const auto* data = static_cast<const uint8_t*>(tri.indexData.hostAddress) + range.primitiveOffset;
-  const uint32_t largest = LargestIndex(data, uint64_t{range.primitiveCount} * 3, index_size);
+  const uint32_t largest = LargestIndex(data, count, index_size);
   if (uint64_t{range.firstVertex} + largest <= tri.maxVertex) return false;
   return ReportLargestIndex(ctx, cmd, i, j, largest);
 }

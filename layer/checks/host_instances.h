@@ -10,17 +10,22 @@
 #include <vector>
 
 #include "build_command.h"
+#include "device_state.h"
 
 namespace asval {
 
 // Appends to `out` the non-zero references of the instances geometry j of pInfos[i] builds (host builds; instance
 // geometries with a known count), then sorts and removes duplicates from all of `out`. False, leaving `out`
 // alone, when the data cannot be read here: not a host build, not an instance geometry, no range, a null data
-// pointer (pInfos-03778 says so), or motion instances (a layout this reader does not walk).
-bool CollectInstanceReferences(const BuildCommand& cmd, uint32_t i, uint32_t j, std::vector<uint64_t>& out);
+// pointer (pInfos-03778 says so), motion instances (a layout this reader does not walk), or, on a device without
+// host commands, data outside the app's mappings (host_reads.h); instances whose pointer is null or outside them
+// are passed over.
+bool CollectInstanceReferences(const DeviceState& state, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                               std::vector<uint64_t>& out);
 
 // Index of the first instance of geometry j of pInfos[i] whose reference is `reference` (for messages); the
 // count when none is.
-uint32_t FirstInstanceReferencing(const BuildCommand& cmd, uint32_t i, uint32_t j, uint64_t reference);
+uint32_t FirstInstanceReferencing(const DeviceState& state, const BuildCommand& cmd, uint32_t i, uint32_t j,
+                                  uint64_t reference);
 
 }  // namespace asval
