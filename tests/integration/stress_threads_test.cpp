@@ -4,14 +4,14 @@
 // queue (under the app's lock, as vkQueueSubmit requires) and wait for each submission's fence; 2 threads destroy
 // finished jobs' objects and, meanwhile, create and destroy buffers, memory and structures no job uses. Both runs
 // must report exactly the faults: each fault's VUID once, naming the command buffer of the job that made it, and
-// nothing about valid work. Under ThreadSanitizer (the tsan preset) this is the layer's stress test of recording,
-// submission, completion and destruction racing each other.
+// nothing about valid work; a finding made when a submission completed must have arrived when the app's wait for
+// that submission returns, whichever thread's call processed the completion. Under ThreadSanitizer (the tsan
+// preset) this is the layer's stress test of recording, submission, completion and destruction racing each other.
 #include <catch2/catch_test_macros.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
-#include <cstdio>
 #include <deque>
 #include <map>
 #include <memory>
