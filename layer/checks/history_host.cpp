@@ -82,7 +82,8 @@ namespace {
 // counted. Said only when something failed.
 void ReportFailureSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
   const FailureCounters& f = state.failures();
-  if (!f.any()) return;
+  const uint64_t reports_lost = reporter.ReportsLost();
+  if (!f.any() && reports_lost == 0) return;
   const auto n = [](const std::atomic<uint64_t>& counter) { return counter.load(std::memory_order_relaxed); };
   reporter.Report(
       Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
@@ -91,15 +92,17 @@ void ReportFailureSummary(const DeviceState& state, Reporter& reporter, VkDevice
                   "could not be applied with {} operations left unchecked, {} structures' histories made unknown, "
                   "{} commands' captures dropped); capture memory could not be had {} times (those infos were "
                   "not captured); its own Vulkan objects (fence, reducing pipeline) could not be made {} times ({} "
-                  "submissions' captures never read, {} capture checks not run{}). What these left unknown was "
-                  "skipped and counted, never guessed; the app's calls went through with their own results.",
+                  "submissions' captures never read, {} capture checks not run{}); {} messages could not be built. "
+                  "What these left unknown was skipped and counted, never guessed; the app's calls went through with "
+                  "their own results.",
                   n(f.allocation_failures), n(f.objects_untracked), n(f.recordings_lost), n(f.host_commands_lost),
                   n(f.submissions_unknown), n(f.operations_unchecked), n(f.structures_made_unknown),
                   n(f.capture_commands_dropped), n(f.capture_memory_failures), n(f.inserted_failures),
                   n(f.submissions_captures_unread), n(f.capture_checks_unread),
                   f.reduce_pipeline_failed.load(std::memory_order_relaxed)
                       ? "; the reducing pipeline failed, so the captures were copied instead"
-                      : ""));
+                      : "",
+                  reports_lost));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <cinttypes>
 #include <cstring>
+#include <new>
 #include <nlohmann/json.hpp>
 
 #include "vk_enum_string.h"
@@ -110,12 +111,27 @@ bool Reporter::CountDuplicate(uint32_t hash, bool* last) {
 
 bool Reporter::Report(Severity severity, std::string_view vuid_in, const Location& loc,
                       std::initializer_list<ReportObject> objects, std::string_view message) {
-  if (!SeverityEnabled(severity)) return false;
+  bool skip = false;
+  try {
+    ReportOrThrow(severity, vuid_in, loc, objects, message, &skip);
+  } catch (const std::bad_alloc&) {
+    // The message could not be built or written (the layer's allocation failed, or a callback's): lost, counted
+    // (ASVAL-History-Summary says how many), never thrown into the app's Vulkan call. A callback that already
+    // asked to skip the call still has its way.
+    reports_lost_.fetch_add(1, std::memory_order_relaxed);
+  }
+  return skip;
+}
+
+void Reporter::ReportOrThrow(Severity severity, std::string_view vuid_in, const Location& loc,
+                             std::initializer_list<ReportObject> objects, std::string_view message, bool* skip_out) {
+  bool& skip = *skip_out;
+  if (!SeverityEnabled(severity)) return;
   const std::string_view vuid = NewestVuid(vuid_in);
   const uint32_t hash = MessageIdHash(vuid);
-  if (filter_.Mutes(vuid, hash)) return false;
+  if (filter_.Mutes(vuid, hash)) return;
   bool last = false;
-  if (!CountDuplicate(hash, &last)) return false;
+  if (!CountDuplicate(hash, &last)) return;
   CounterFor(severity).fetch_add(1, std::memory_order_relaxed);
 
   const VuidInfo* info = FindVuid(vuid);
@@ -175,7 +191,6 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
   data.pObjects = object_infos.data();
 
   const VkDebugUtilsMessageSeverityFlagBitsEXT vk_severity = ToDebugUtilsSeverity(severity);
-  bool skip = false;
   bool delivered = false;
   {
     // Copy the list so that no lock is held while app code runs (a callback may call Vulkan).
@@ -196,7 +211,6 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
     stderr_logger_->log(LogLevel(severity), text);
   }
   WriteJson(severity, vuid, hash, loc, objects, message, spec_text);
-  return skip;
 }
 
 std::atomic<uint64_t>& Reporter::CounterFor(Severity severity) {

@@ -69,6 +69,9 @@ class Reporter {
   uint64_t ErrorCount() const { return error_count_.load(std::memory_order_relaxed); }
   uint64_t WarningCount() const { return warning_count_.load(std::memory_order_relaxed); }
   uint64_t InfoCount() const { return info_count_.load(std::memory_order_relaxed); }
+  // Messages that could not be built or written: an allocation failed (std::bad_alloc is caught, never thrown
+  // into the app's call).
+  uint64_t ReportsLost() const { return reports_lost_.load(std::memory_order_relaxed); }
 
   // A line for the layer's own problems (bad settings, internal failures): stderr and the report file.
   void LayerNotice(Severity severity, std::string_view text);
@@ -82,6 +85,9 @@ class Reporter {
     void* user_data;
   };
 
+  // Report's body; *skip is set as soon as a callback asks to skip, so that it stands if a later step throws.
+  void ReportOrThrow(Severity severity, std::string_view vuid, const Location& loc,
+                     std::initializer_list<ReportObject> objects, std::string_view message, bool* skip);
   bool SeverityEnabled(Severity s) const;
   // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
   bool CountDuplicate(uint32_t hash, bool* last);
@@ -107,6 +113,7 @@ class Reporter {
   std::FILE* json_file_ = nullptr;
 
   std::shared_ptr<spdlog::logger> stderr_logger_;
+  std::atomic<uint64_t> reports_lost_{0};
   std::atomic<uint64_t> error_count_{0};
   std::atomic<uint64_t> warning_count_{0};
   std::atomic<uint64_t> info_count_{0};

@@ -361,5 +361,39 @@ TEST_CASE("failure injection unit: ASVAL-History-Summary says what the failures 
   CHECK(said);
 }
 
+// An app callback whose own allocation fails: the message is lost, counted, and nothing is thrown into the call.
+VKAPI_ATTR VkBool32 VKAPI_CALL ThrowingCallback(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                                                const VkDebugUtilsMessengerCallbackDataEXT*, void*) {
+  throw std::bad_alloc();
+}
+
+TEST_CASE("failure injection unit: a message that could not be delivered is counted and said, never thrown") {
+  asval_test_common::TempReport file;
+  {
+    ReportSettings settings;
+    settings.report_file = file.path;
+    settings.report_info = true;
+    Reporter reporter(settings);
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;  // the summary (info) is not sent there
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    info.pfnUserCallback = &ThrowingCallback;
+    reporter.AddMessenger(Fake<VkDebugUtilsMessengerEXT>(1), info);
+    bool skip = true;
+    CHECK_NOTHROW(skip = reporter.Report(Severity::kError, "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03667",
+                                         Location("vkQueueSubmit"), {}, "a finding"));
+    CHECK_FALSE(skip);
+    CHECK(reporter.ReportsLost() == 1);
+    World w;  // nothing else failed: the summary says only the lost message
+    ReportHistorySummary(w.state, reporter, VK_NULL_HANDLE);
+  }
+  bool said = false;
+  for (const std::string& line : file.Lines()) {
+    said |= line.find("could not allocate 0 times") != std::string::npos &&
+            line.find("; 1 messages could not be built.") != std::string::npos;
+  }
+  CHECK(said);
+}
+
 }  // namespace
 }  // namespace asval
