@@ -199,7 +199,12 @@ TEST_CASE("None-03407 / dstAccelerationStructure-03706: host-build instances ref
   blas.infos[0].dstAccelerationStructure = memory.Structure(storage, 0, size, kBottom);
   const VkAccelerationStructureKHR twin = memory.Structure(storage, 0, size, kBottom);  // same bytes, other handle
   std::vector<unsigned char> host_scratch(1 << 16);
-  VkAccelerationStructureInstanceKHR instance{};
+  // The instance in mapped memory: without accelerationStructureHostCommands (lavapipe) the layer reads a host
+  // build's inputs only inside the app's mappings (layer/checks/host_reads.h).
+  vkkit::Buffer instance_memory =
+      device.CreateBuffer(sizeof(VkAccelerationStructureInstanceKHR), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  auto& instance = *static_cast<VkAccelerationStructureInstanceKHR*>(instance_memory.mapped);
+  instance = VkAccelerationStructureInstanceKHR{};
   instance.mask = 0xff;
   VkAccelerationStructureGeometryKHR instances = scene.Instances();
   instances.geometry.instances.data.hostAddress = &instance;
@@ -222,6 +227,7 @@ TEST_CASE("None-03407 / dstAccelerationStructure-03706: host-build instances ref
   }
   CallHostBuild(device, infos, {&range, &range});
   CHECK(f.monitor().Verify() == "");
+  device.Destroy(instance_memory);
 }
 
 // ---- valid twins: every family on, built for real on lavapipe

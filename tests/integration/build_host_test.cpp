@@ -4,6 +4,7 @@
 // as do the rules lavapipe's memory cannot break (it has one memory type, host-visible; no device groups).
 #include <catch2/catch_test_macros.hpp>
 
+#include <cstring>
 #include <vector>
 
 #include "memory_placement_helpers.h"
@@ -136,8 +137,14 @@ TEST_CASE("pInfos-03779: an instance referencing a destroyed structure is report
   vkkit::AccelerationStructure gone = device.CreateAccelerationStructure(kBottom, 256);
   build.instance.accelerationStructureReference = reinterpret_cast<uint64_t>(gone.handle);
   device.Destroy(gone);
+  // The instance in mapped memory: without accelerationStructureHostCommands (lavapipe) the layer reads a host
+  // build's inputs only inside the app's mappings (layer/checks/host_reads.h).
+  vkkit::Buffer mapped = device.CreateBuffer(sizeof(build.instance), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(mapped.mapped, &build.instance, sizeof(build.instance));
+  build.geometry.geometry.instances.data.hostAddress = mapped.mapped;
   f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-pInfos-03779");
   build.Call(device);
+  device.Destroy(mapped);
   const std::vector<Message> messages = f.monitor().Take();
   REQUIRE(messages.size() == 1);
   CHECK(messages[0].text.find("instance 0") != std::string::npos);
