@@ -50,8 +50,13 @@ def parse_args(argv: List[str]) -> argparse.Namespace:
     p.add_argument("--rss-tolerance-kb", type=int, default=1024,
                    help="resident memory at the last two counts may differ by this much and still be flat")
     p.add_argument("--skip-baseline", action="store_true", help="do not run the scene without the layer")
+    p.add_argument("--layer-env", action="append", default=[], metavar="VAR=VALUE",
+                   help="an environment variable for the runs under the layer, e.g. "
+                        "VK_ASVAL_AS_VALIDATION_CAPTURE=all (repeatable)")
     args = p.parse_args(argv)
     args.counts = [int(x) for x in args.frames.split(",")]
+    if any("=" not in item for item in args.layer_env):
+        p.error("--layer-env: VAR=VALUE")
     if args.counts != sorted(set(args.counts)) or args.counts[0] < 1:
         p.error("--frames: ascending positive counts")
     return args
@@ -89,6 +94,7 @@ def run_scene(args, frames: int, with_layer: bool, env: Dict[str, str]) -> Dict:
         # Information messages on, for the footprint; everything else the layer's defaults (capture=updates).
         env["VK_ASVAL_AS_VALIDATION_REPORT_FILE"] = report
         env["VK_ASVAL_AS_VALIDATION_REPORT_FLAGS"] = "error,warn,info"
+        env.update(dict(item.split("=", 1) for item in args.layer_env))
     started = time.monotonic()
     with tempfile.TemporaryFile("w+") as out_file, tempfile.TemporaryFile("w+") as err_file:
         proc = subprocess.Popen(argv, env=env, stdout=out_file, stderr=err_file, text=True)
