@@ -36,7 +36,8 @@ class GeometryFactsReader {
       return GeometryFacts{g, VertexFormatFacts(VK_FORMAT_UNDEFINED), kNoFeatures, 0};
     }
     const VkAccelerationStructureGeometryTrianglesDataKHR& tri = g.geometry.triangles;
-    if (tri.vertexFormat != format_) {
+    // row_ is null until a first lookup, and an app may pass VK_FORMAT_MAX_ENUM, the value format_ starts at.
+    if (tri.vertexFormat != format_ || !row_) {
       format_ = tri.vertexFormat;
       row_ = &VertexFormatFacts(format_);
       features_ = state_.format_features.BufferFeatures(format_);
