@@ -26,13 +26,15 @@ VkAccelerationStructureTypeKHR ChooseType(ByteSource& in) {
   switch (in.Below(6)) {
     case 0: return VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
     case 1: return VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR;
-    case 2: return static_cast<VkAccelerationStructureTypeKHR>(in.U32());
+    case 2: return in.AnyEnum<VkAccelerationStructureTypeKHR>();
     default: return VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   }
 }
 
 VkGeometryTypeKHR ChooseGeometryType(ByteSource& in, VkAccelerationStructureTypeKHR info_type) {
-  if (in.OneIn(8)) return static_cast<VkGeometryTypeKHR>(in.Bit() ? in.U32() : in.Below(4));
+  if (in.OneIn(8)) {
+    return in.Bit() ? in.AnyEnum<VkGeometryTypeKHR>() : static_cast<VkGeometryTypeKHR>(in.Below(4));
+  }
   if (info_type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && !in.OneIn(4)) return VK_GEOMETRY_TYPE_INSTANCES_KHR;
   return in.Bit() ? VK_GEOMETRY_TYPE_TRIANGLES_KHR : VK_GEOMETRY_TYPE_AABBS_KHR;
 }
@@ -43,7 +45,7 @@ VkFormat ChooseVertexFormat(ByteSource& in) {
       VK_FORMAT_R16G16_SFLOAT,       VK_FORMAT_R16G16_SNORM,          VK_FORMAT_R16G16B16A16_SNORM,
       VK_FORMAT_R8G8B8A8_SNORM,      VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_FORMAT_R64G64B64_SFLOAT,
       VK_FORMAT_R16G16B16A16_UNORM,  VK_FORMAT_UNDEFINED};
-  if (in.OneIn(12)) return static_cast<VkFormat>(in.U32());
+  if (in.OneIn(12)) return in.AnyEnum<VkFormat>();
   return in.Pick(kFormats);
 }
 
@@ -52,7 +54,7 @@ VkIndexType ChooseIndexType(ByteSource& in) {
     case 0: return VK_INDEX_TYPE_UINT16;
     case 1: return VK_INDEX_TYPE_UINT32;
     case 2: return VK_INDEX_TYPE_UINT8_EXT;
-    case 3: return static_cast<VkIndexType>(in.U32());
+    case 3: return in.AnyEnum<VkIndexType>();
     default: return VK_INDEX_TYPE_NONE_KHR;
   }
 }
@@ -104,7 +106,7 @@ BuildCall::BuildCall(ByteSource& in, SyntheticDevice& device, BuildCommandKind k
 void BuildCall::DecodeInfo(ByteSource& in, uint32_t i) {
   VkAccelerationStructureBuildGeometryInfoKHR& info = infos_[i];
   info = VkAccelerationStructureBuildGeometryInfoKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  if (in.OneIn(16)) info.sType = static_cast<VkStructureType>(in.U32());
+  if (in.OneIn(16)) info.sType = in.AnyEnum<VkStructureType>();
   info.pNext = Chain(in);
   info.type = ChooseType(in);
   info.flags = in.U8() & 0x1f;
@@ -113,7 +115,7 @@ void BuildCall::DecodeInfo(ByteSource& in, uint32_t i) {
   switch (in.Below(6)) {
     case 0:
     case 1: info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR; break;
-    case 2: info.mode = static_cast<VkBuildAccelerationStructureModeKHR>(in.U32()); break;
+    case 2: info.mode = in.AnyEnum<VkBuildAccelerationStructureModeKHR>(); break;
     default: info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR; break;
   }
   info.srcAccelerationStructure = device_.Structure(in);
@@ -211,7 +213,7 @@ void BuildCall::DecodeRange(ByteSource& in, VkAccelerationStructureBuildRangeInf
 void BuildCall::DecodeGeometry(ByteSource& in, const VkAccelerationStructureBuildGeometryInfoKHR& info,
                                VkAccelerationStructureGeometryKHR& g, VkAccelerationStructureBuildRangeInfoKHR& range) {
   g = VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-  if (in.OneIn(16)) g.sType = static_cast<VkStructureType>(in.U32());
+  if (in.OneIn(16)) g.sType = in.AnyEnum<VkStructureType>();
   g.pNext = Chain(in);
   g.geometryType = ChooseGeometryType(in, info.type);
   g.flags = in.OneIn(8) ? in.U32() : in.U8() & 3u;
@@ -219,7 +221,7 @@ void BuildCall::DecodeGeometry(ByteSource& in, const VkAccelerationStructureBuil
   switch (g.geometryType) {
     case VK_GEOMETRY_TYPE_TRIANGLES_KHR: {
       VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
-      t.sType = in.OneIn(16) ? static_cast<VkStructureType>(in.U32())
+      t.sType = in.OneIn(16) ? in.AnyEnum<VkStructureType>()
                              : VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
       t.pNext = Chain(in);
       t.vertexFormat = ChooseVertexFormat(in);
@@ -237,7 +239,7 @@ void BuildCall::DecodeGeometry(ByteSource& in, const VkAccelerationStructureBuil
     }
     case VK_GEOMETRY_TYPE_AABBS_KHR: {
       VkAccelerationStructureGeometryAabbsDataKHR& a = g.geometry.aabbs;
-      a.sType = in.OneIn(16) ? static_cast<VkStructureType>(in.U32())
+      a.sType = in.OneIn(16) ? in.AnyEnum<VkStructureType>()
                              : VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
       a.pNext = Chain(in);
       const VkDeviceSize strides[] = {24, 32, 0, 8, 23, 64};
@@ -248,7 +250,7 @@ void BuildCall::DecodeGeometry(ByteSource& in, const VkAccelerationStructureBuil
     }
     case VK_GEOMETRY_TYPE_INSTANCES_KHR: {
       VkAccelerationStructureGeometryInstancesDataKHR& d = g.geometry.instances;
-      d.sType = in.OneIn(16) ? static_cast<VkStructureType>(in.U32())
+      d.sType = in.OneIn(16) ? in.AnyEnum<VkStructureType>()
                              : VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
       d.pNext = Chain(in);
       d.arrayOfPointers = in.Bit() ? VK_TRUE : VK_FALSE;
@@ -259,6 +261,7 @@ void BuildCall::DecodeGeometry(ByteSource& in, const VkAccelerationStructureBuil
     default: {  // a type the layer does not know: its union is bytes, never pointers the layer may follow
       uint8_t bytes[sizeof(g.geometry)];
       for (uint8_t& b : bytes) b = in.U8();
+      for (size_t k = 3; k < sizeof(bytes); k += 4) bytes[k] &= 0x7f;  // its enum fields within MAX_ENUM (AnyEnum)
       std::memcpy(&g.geometry, bytes, sizeof(bytes));
       return;
     }
@@ -329,7 +332,7 @@ const void* BuildCall::Chain(ByteSource& in) {
     auto node = std::make_unique<ChainNode>();
     std::memset(node->bytes, 0, sizeof(node->bytes));  // known structures: null pointers, zero counts
     const bool known = in.Bit();
-    const VkStructureType type = known ? KnownChainType(in) : static_cast<VkStructureType>(in.U32());
+    const VkStructureType type = known ? KnownChainType(in) : in.AnyEnum<VkStructureType>();
     const VkBaseInStructure header{type, static_cast<const VkBaseInStructure*>(next)};
     if (!known) {  // a structure the layer cannot know: any bytes after its header
       const uint64_t word = in.U64();

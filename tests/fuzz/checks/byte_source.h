@@ -30,6 +30,12 @@ class ByteSource {
     return low | (static_cast<uint64_t>(U32()) << 32);
   }
   bool Bit() { return (U8() & 1) != 0; }
+  // A value of enum type E that may be no enumerator: up to 0x7FFFFFFF, the headers' MAX_ENUM. (Past it, a C app
+  // can pass the value, but loading it as the C++ enum is undefined behaviour in any C++ layer: UBSan says so.)
+  template <typename E>
+  E AnyEnum() {
+    return static_cast<E>(U32() & 0x7fffffffu);
+  }
   // A value in [0, n), n > 0; one byte when n fits in one.
   uint32_t Below(uint32_t n) { return n <= 256 ? U8() % n : U32() % n; }
   // True about once in n reads (never for an exhausted input).

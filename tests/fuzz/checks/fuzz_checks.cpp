@@ -29,7 +29,7 @@ VkResult HostResult(ByteSource& in, VkDeferredOperationKHR deferred) {
 }
 
 VkCopyAccelerationStructureModeKHR ChooseCopyMode(ByteSource& in) {
-  if (in.OneIn(4)) return static_cast<VkCopyAccelerationStructureModeKHR>(in.Bit() ? in.U32() : in.Below(4));
+  if (in.OneIn(4) && in.Bit()) return in.AnyEnum<VkCopyAccelerationStructureModeKHR>();
   return static_cast<VkCopyAccelerationStructureModeKHR>(in.Below(4));
 }
 
@@ -97,7 +97,8 @@ void RunSerialization(ByteSource& in, SyntheticDevice& device, CheckRunner& runn
     } else {
       info.dst.deviceAddress = device.DeviceAddress(in);
     }
-    const char* function = host ? "vkCopyAccelerationStructureToMemoryKHR" : "vkCmdCopyAccelerationStructureToMemoryKHR";
+    const char* function =
+        host ? "vkCopyAccelerationStructureToMemoryKHR" : "vkCmdCopyAccelerationStructureToMemoryKHR";
     RunHostRules(runner, device.state(), nullptr, function,
                  [&](const CheckContext& ctx) { return ValidateCopyToMemoryInfo(ctx, function, cb, info); });
     return;
@@ -123,7 +124,7 @@ void RunWriteProperties(ByteSource& in, SyntheticDevice& device, CheckRunner& ru
                                VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR,
                                VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_BOTTOM_LEVEL_POINTERS_KHR,
                                VK_QUERY_TYPE_OCCLUSION, VK_QUERY_TYPE_TIMESTAMP};
-  const VkQueryType type = in.OneIn(8) ? static_cast<VkQueryType>(in.U32()) : in.Pick(types);
+  const VkQueryType type = in.OneIn(8) ? in.AnyEnum<VkQueryType>() : in.Pick(types);
   const uint32_t count = static_cast<uint32_t>(structures.size());
   const VkAccelerationStructureKHR* data = structures.empty() && in.Bit() ? nullptr : structures.data();
   if (in.Bit()) {

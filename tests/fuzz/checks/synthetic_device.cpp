@@ -28,7 +28,8 @@ VKAPI_ATTR VkDeviceAddress VKAPI_CALL FakeBufferAddress(VkDevice, const VkBuffer
   return g_driver.next_address;
 }
 
-VKAPI_ATTR VkDeviceAddress VKAPI_CALL FakeStructureAddress(VkDevice, const VkAccelerationStructureDeviceAddressInfoKHR*) {
+VKAPI_ATTR VkDeviceAddress VKAPI_CALL FakeStructureAddress(VkDevice,
+                                                           const VkAccelerationStructureDeviceAddressInfoKHR*) {
   return g_driver.next_address;
 }
 
@@ -50,7 +51,8 @@ VKAPI_ATTR void VKAPI_CALL FakeFormatProperties(VkPhysicalDevice, VkFormat forma
 // Reads every geometry and count the layer passes, as a driver would (a short array is a sanitizer report), and
 // answers sizes that grow with the counts.
 VKAPI_ATTR void VKAPI_CALL FakeBuildSizes(VkDevice, VkAccelerationStructureBuildTypeKHR,
-                                          const VkAccelerationStructureBuildGeometryInfoKHR* info, const uint32_t* counts,
+                                          const VkAccelerationStructureBuildGeometryInfoKHR* info,
+                                          const uint32_t* counts,
                                           VkAccelerationStructureBuildSizesInfoKHR* sizes) {
   uint64_t primitives = 0;
   for (uint32_t j = 0; j < info->geometryCount; ++j) {
@@ -203,8 +205,8 @@ void SyntheticDevice::CreateBuffers(ByteSource& in) {
   const uint32_t count = in.Below(9);
   for (uint32_t k = 0; k < count; ++k) {
     VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    const VkDeviceSize sizes[] = {256, 4096, VkDeviceSize{1} << 20, VkDeviceSize{1} + in.U8(), VkDeviceSize{1} + in.U32(),
-                                  in.U64() >> in.Below(64)};
+    const VkDeviceSize sizes[] = {256, 4096, VkDeviceSize{1} << 20, VkDeviceSize{1} + in.U8(),
+                                  VkDeviceSize{1} + in.U32(), in.U64() >> in.Below(64)};
     info.size = in.Pick(sizes);
     if (info.size == 0) info.size = 1;
     info.usage = ChooseUsage(in);
@@ -232,7 +234,7 @@ void SyntheticDevice::CreateStructures(ByteSource& in) {
                                                   : buffers_[in.Below(static_cast<uint32_t>(buffers_.size()))];
     const VkAccelerationStructureTypeKHR types[] = {
         VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-        VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR, static_cast<VkAccelerationStructureTypeKHR>(in.U32())};
+        VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR, in.AnyEnum<VkAccelerationStructureTypeKHR>()};
     info.type = in.Pick(types);
     info.createFlags = in.OneIn(4) ? in.U32() : 0;
     info.offset = in.Bit() ? 0 : VkDeviceSize{in.U16()} << (in.Bit() ? 8 : 0);
@@ -257,7 +259,7 @@ void SyntheticDevice::CreatePoolsAndCommandBuffers(ByteSource& in) {
                                  VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR,
                                  VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR,
                                  VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_BOTTOM_LEVEL_POINTERS_KHR,
-                                 VK_QUERY_TYPE_OCCLUSION, static_cast<VkQueryType>(in.U32())};
+                                 VK_QUERY_TYPE_OCCLUSION, in.AnyEnum<VkQueryType>()};
     info.queryType = in.Pick(types);
     info.queryCount = in.Bit() ? in.U8() : in.U32();
     const VkQueryPool pool = Handle<VkQueryPool>(NextHandle());
