@@ -73,7 +73,10 @@ bool ValidateHostOps(const CheckContext& ctx, const OpBatch& batch, const char* 
 bool ValidateBuildHistory(const CheckContext& ctx, const BuildCommand& cmd) {
   if (!cmd.is_host() || !cmd.infos) return false;  // device builds: checked at submission
   return ValidateHostOps(
-      ctx, HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges, cmd.host_capture, cmd.host_captured), cmd.function);
+      ctx,
+      HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges, cmd.host_capture, cmd.host_captured,
+                   ctx.state.properties.acceleration_structure.maxGeometryCount),
+      cmd.function);
 }
 
 namespace {

@@ -20,7 +20,8 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
                                  const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                                  const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                                  std::vector<uint32_t>& captured) {
-  if (!data.capture_tracker || !infos) return nullptr;
+  // Null arrays break implicit rules asval leaves to the Khronos layer; the capture must not read them either.
+  if (!data.capture_tracker || !infos || !ranges) return nullptr;
   bool any = false;
   for (uint32_t i = 0; i < info_count && !any; ++i) any = NeedsCapture(data.instance->settings.capture, infos[i]);
   if (!any) return nullptr;
@@ -119,7 +120,8 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
   // History: applied now on success, or when the deferred operation completes.
   FinishHostOps(data->state,
-                HostBuildOps(infoCount, pInfos, ppBuildRangeInfos, capture.log.get(), capture.captured_or_null()),
+                HostBuildOps(infoCount, pInfos, ppBuildRangeInfos, capture.log.get(), capture.captured_or_null(),
+                             data->state.properties.acceleration_structure.maxGeometryCount),
                 deferredOperation, result, capture.log);
   return result;
 }

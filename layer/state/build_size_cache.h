@@ -33,6 +33,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "geometry_limit.h"
+
 namespace asval {
 
 struct BuildSizes {
@@ -59,15 +61,6 @@ struct BuildSignature {
   // sizes in a way the signature does not capture: such builds are queried every time, never cached.
   bool Cacheable() const;
 };
-
-// Whether a build info's geometries stay within maxGeometryCount (bottom level; a limit of 0 was not reported).
-// Past it the build is invalid as a whole (type-03793) and its arrays may be shorter than its count: nothing may
-// walk them, neither a signature (Find) nor the driver's size query.
-inline bool GeometryCountWithinLimit(const VkAccelerationStructureBuildGeometryInfoKHR& info,
-                                     uint64_t max_geometry_count) {
-  return info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR || max_geometry_count == 0 ||
-         info.geometryCount <= max_geometry_count;
-}
 
 class BuildSizeCache {
  public:

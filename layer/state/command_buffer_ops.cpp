@@ -4,6 +4,8 @@
 #include <cinttypes>
 #include <cstdio>
 
+#include "geometry_limit.h"
+
 namespace asval {
 
 const char* OpCommandName(OpCommand command) {
@@ -134,10 +136,11 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
 void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                            const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* log,
-                           const uint32_t* captured) {
+                           const uint32_t* captured, uint64_t max_geometry_count) {
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
-    const bool has_geometries = info.pGeometries || info.ppGeometries;
+    const bool has_geometries =
+        (info.pGeometries || info.ppGeometries) && GeometryCountWithinLimit(info, max_geometry_count);
     if (has_geometries) {
       // Room for the info's geometries at once (growing geometrically, as push_back would: a reserve of the
       // exact size per info would copy the whole batch on every call). Before the operation is appended, so

@@ -199,10 +199,12 @@ class OpBatch {
 
   // One operation per info of a build command. ranges is null for indirect builds (counts unknown).
   // captured: per info, its index in `log`'s infos plus one (0: not captured); null when nothing was.
+  // max_geometry_count: the device's limit (0: not reported); past it an info's geometries are not read (its arrays
+  // may be shorter than its count, type-03793) and its operation's geometries are unreadable.
   void AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
-                    CaptureLog* log = nullptr, const uint32_t* captured = nullptr);
+                    CaptureLog* log = nullptr, const uint32_t* captured = nullptr, uint64_t max_geometry_count = 0);
   // Any other operation (no geometries).
   void Append(const AsOp& op) { ops_.push_back(op); }
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.

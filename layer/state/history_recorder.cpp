@@ -147,7 +147,8 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
   if (!recording || !infos) return;
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
   Guarded(state, *recording, [&] {
-    recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured);
+    recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured,
+                                      state.properties.acceleration_structure.maxGeometryCount);
   });
 }
 
@@ -243,10 +244,13 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
 // history unknown (FinishHostOps).
 OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                      const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* capture,
-                     const uint32_t* captured) try {
+                     const uint32_t* captured, uint64_t max_geometry_count) try {
   InjectBadAlloc(FailSite::kHostOps);
   OpBatch batch;
-  if (infos) batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges, capture, captured);
+  if (infos) {
+    batch.AppendBuilds(HostOrigin(OpCommand::kHostBuild), info_count, infos, ranges, capture, captured,
+                       max_geometry_count);
+  }
   return batch;
 } catch (const std::bad_alloc&) {
   return LostHostOps();

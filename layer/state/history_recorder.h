@@ -49,9 +49,10 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
 // ---- host commands: their operations (pure: built before the checks run) ----
 // `capture`, `captured`: the inputs captured when the build was called (host_capture.h; null: none): each
 // captured info's operation carries its capture, whose activity is recorded when the operations are applied.
+// max_geometry_count: the device's limit, as OpBatch::AppendBuilds takes it.
 OpBatch HostBuildOps(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                      const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* capture = nullptr,
-                     const uint32_t* captured = nullptr);
+                     const uint32_t* captured = nullptr, uint64_t max_geometry_count = 0);
 OpBatch HostCopyOps(const VkCopyAccelerationStructureInfoKHR& info);
 OpBatch HostCopyToMemoryOps(const VkCopyAccelerationStructureToMemoryInfoKHR& info);
 OpBatch HostCopyMemoryToOps(const VkCopyMemoryToAccelerationStructureInfoKHR& info);

@@ -353,7 +353,14 @@ struct HostTogether {
     std::vector<VkAccelerationStructureBuildGeometryInfoKHR> infos = blas.Host(blas.infos);
     infos.push_back(tlas);
     infos[1].scratchData.hostAddress = host_scratch.data();
+    // The instance in mapped memory: without accelerationStructureHostCommands (lavapipe) asval reads a host
+    // build's inputs only inside the app's mappings (layer/checks/host_reads.h).
+    vkkit::Buffer mapped = device.CreateBuffer(sizeof(instance), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    std::memcpy(mapped.mapped, &instance, sizeof(instance));
+    instances.geometry.instances.data.hostAddress = mapped.mapped;
     CallHostBuild(device, infos, {&blas.range, &blas.range});
+    instances.geometry.instances.data.hostAddress = &instance;
+    device.Destroy(mapped);
   }
 };
 

@@ -58,7 +58,21 @@ struct HostBuild {
     scene.Prepare(info, {1});
     info.scratchData.hostAddress = scratch.data();
   }
-  void Call(vkkit::Device& device) { CallHostBuild(device, {info}, {&range}); }
+  // Instances are copied into mapped memory for the call: without accelerationStructureHostCommands (lavapipe)
+  // asval reads a host build's inputs only inside the app's mappings (layer/checks/host_reads.h).
+  void Call(vkkit::Device& device) {
+    if (geometry.geometryType != VK_GEOMETRY_TYPE_INSTANCES_KHR || geometry.geometry.instances.arrayOfPointers ||
+        geometry.geometry.instances.data.hostAddress != &instance) {
+      CallHostBuild(device, {info}, {&range});
+      return;
+    }
+    vkkit::Buffer mapped = device.CreateBuffer(sizeof(instance), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    std::memcpy(mapped.mapped, &instance, sizeof(instance));
+    geometry.geometry.instances.data.hostAddress = mapped.mapped;
+    CallHostBuild(device, {info}, {&range});
+    geometry.geometry.instances.data.hostAddress = &instance;
+    device.Destroy(mapped);
+  }
 };
 
 // ---- scratch
@@ -170,13 +184,24 @@ CORPUS_CASE(DestroyedReferenceByPointer, "host-instance-pointer-to-destroyed-bla
   VkAccelerationStructureInstanceKHR second = build.instance;
   second.accelerationStructureReference = reinterpret_cast<uint64_t>(gone.handle);
   device.Destroy(gone);
-  const VkAccelerationStructureInstanceKHR* pointers[2] = {&build.instance, &second};
+  // The two instances and the array of pointers to them in mapped memory (see HostBuild::Call).
+  struct Mapped {
+    VkAccelerationStructureInstanceKHR instances[2];
+    const VkAccelerationStructureInstanceKHR* pointers[2];
+  };
+  vkkit::Buffer mapped = device.CreateBuffer(sizeof(Mapped), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  Mapped* m = static_cast<Mapped*>(mapped.mapped);
+  m->instances[0] = build.instance;
+  m->instances[1] = second;
+  m->pointers[0] = &m->instances[0];
+  m->pointers[1] = &m->instances[1];
   build.geometry.geometry.instances.arrayOfPointers = VK_TRUE;
-  build.geometry.geometry.instances.data.hostAddress = pointers;
+  build.geometry.geometry.instances.data.hostAddress = m->pointers;
   build.range.primitiveCount = 2;
   scene.Prepare(build.info, {2});  // a destination sized for 2 instances
   build.info.scratchData.hostAddress = build.scratch.data();
   build.Call(device);
+  device.Destroy(mapped);
 }
 
 // ---- feature-only twins: nothing but the missing feature is wrong
@@ -225,9 +250,12 @@ CORPUS_CASE(ManyInstancesOneBlas, "host-feature-only-1000-instances-of-one-blas"
   prototype.transform.matrix[0][0] = prototype.transform.matrix[1][1] = prototype.transform.matrix[2][2] = 1.0f;
   prototype.mask = 0xff;
   prototype.accelerationStructureReference = reinterpret_cast<uint64_t>(scene.blas());
-  std::vector<VkAccelerationStructureInstanceKHR> instances(kInstances, prototype);
+  // In mapped memory, where asval reads them without host commands (see HostBuild::Call).
+  vkkit::Buffer mapped = device.CreateBuffer(kInstances * sizeof(prototype), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  auto* instances = static_cast<VkAccelerationStructureInstanceKHR*>(mapped.mapped);
+  for (uint32_t i = 0; i < kInstances; ++i) instances[i] = prototype;
   VkAccelerationStructureGeometryKHR g = scene.Instances();
-  g.geometry.instances.data.hostAddress = instances.data();
+  g.geometry.instances.data.hostAddress = instances;
   VkAccelerationStructureBuildGeometryInfoKHR info = Scene::Info(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, {g});
   info.pGeometries = &g;
   const VkAccelerationStructureBuildSizesInfoKHR sizes = DriverSizes(device, info, {kInstances});
@@ -237,6 +265,7 @@ CORPUS_CASE(ManyInstancesOneBlas, "host-feature-only-1000-instances-of-one-blas"
   info.scratchData.hostAddress = scratch.data();
   const VkAccelerationStructureBuildRangeInfoKHR range{kInstances, 0, 0, 0};
   CallHostBuild(device, {info}, {&range});
+  device.Destroy(mapped);
 }
 
 }  // namespace

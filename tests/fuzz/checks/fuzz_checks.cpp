@@ -33,21 +33,16 @@ VkCopyAccelerationStructureModeKHR ChooseCopyMode(ByteSource& in) {
   return static_cast<VkCopyAccelerationStructureModeKHR>(in.Below(4));
 }
 
-// Open finding (issue 14, fuzz-checks report): the history recorder (OpBatch::AppendBuilds, reached through
-// HostBuildOps by the history family and by the host build's hook) walks every geometry of a bottom-level info
-// past maxGeometryCount, whose array may be shorter than its count. Until it stops at the limit as the check
-// families do, host builds with such an array run without the history family and change no history.
-constexpr bool kRecorderStopsAtGeometryLimit = false;
-
 void RunBuild(ByteSource& in, SyntheticDevice& device, CheckRunner& runner, BuildCommandKind kind) {
   const BuildCall call(in, device, kind);
   const BuildCommand& cmd = call.command();
-  const bool recorder_safe = kRecorderStopsAtGeometryLimit || !cmd.is_host() || !call.short_arrays();
-  const bool skip = runner.Run([&](const CheckContext& ctx) { return ValidateBuildCommand(ctx, cmd); },
-                               recorder_safe ? 0u : uint32_t{kCheckHistory});
-  if (skip || !cmd.is_host() || !recorder_safe) return;  // device builds change the history at submission
-  FinishHostOps(device.state(), HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges), cmd.deferred_operation,
-                HostResult(in, cmd.deferred_operation));
+  const bool skip = runner.Run([&](const CheckContext& ctx) { return ValidateBuildCommand(ctx, cmd); });
+  if (skip || !cmd.is_host()) return;  // device builds change the history at submission
+  // As the host build's hook does, past maxGeometryCount included (the recorder stops there: geometry_limit.h).
+  FinishHostOps(device.state(),
+                HostBuildOps(cmd.info_count, cmd.infos, cmd.ranges, nullptr, nullptr,
+                             device.state().properties.acceleration_structure.maxGeometryCount),
+                cmd.deferred_operation, HostResult(in, cmd.deferred_operation));
 }
 
 // A host copy runs the copies family and the history rules over its operations, as the hook does.
