@@ -8,6 +8,7 @@
 #include "host_capture.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
+#include "withhold.h"
 
 namespace asval::hooks {
 
@@ -47,7 +48,10 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.infos = pInfos;
   cmd.ranges = ppBuildRangeInfos;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
+  const ProtectScope protect;
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) {
+    return WithholdRecordedCommand(*data, cmd.function, commandBuffer, protect);
+  }
   const uint32_t* captured = PreRecordCapture(*data, commandBuffer, infoCount, pInfos, ppBuildRangeInfos,
                                               thread.data().captured_infos);
   data->dispatch.CmdBuildAccelerationStructuresKHR(commandBuffer, infoCount, pInfos, ppBuildRangeInfos);
@@ -69,7 +73,10 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   cmd.indirect_strides = pIndirectStrides;
   cmd.max_primitive_counts = ppMaxPrimitiveCounts;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) return;
+  const ProtectScope protect;
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) {
+    return WithholdRecordedCommand(*data, cmd.function, commandBuffer, protect);
+  }
   // Pre-record: the range infos the device will read, copied when the build executes (layer/capture).
   const uint32_t* captured = nullptr;
   if (data->capture_tracker) {
@@ -113,9 +120,9 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
     cmd.host_capture = capture.log.get();
     cmd.host_captured = capture.captured_or_null();
   }
-  // Skipped by the app's callback: the build did not happen. VK_ERROR_VALIDATION_FAILED_EXT is what the
-  // Khronos layer returns in that case.
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return VK_ERROR_VALIDATION_FAILED_EXT;
+  // Skipped by the app's callback, or withheld by protect mode: the build did not happen.
+  const ProtectScope protect;
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return WithholdHostCommand(*data, cmd.function, device, protect);
   const VkResult result =
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
   // History: applied now on success, or when the deferred operation completes.

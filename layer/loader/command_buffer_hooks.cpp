@@ -75,6 +75,8 @@ VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uin
   DeviceData* data = GetDeviceData(commandBuffer);
   data->dispatch.CmdExecuteCommands(commandBuffer, commandBufferCount, pCommandBuffers);
   RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);
+  // Protect mode: a secondary holding a withheld command marks the primary (a single load until one is marked).
+  data->state.command_buffers.InheritWithheld(commandBuffer, commandBufferCount, pCommandBuffers);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBindPipeline(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,

@@ -6,6 +6,7 @@
 #include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
+#include "withhold.h"
 
 namespace asval::hooks {
 
@@ -16,13 +17,13 @@ template <typename MakeOps, typename Validate, typename Downcall>
 VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR deferred, MakeOps&& make_ops,
                   Validate&& validate, Downcall&& downcall) {
   const CheckContext ctx = MakeCheckContext(data);
+  const ProtectScope protect;
   bool skip = ctx.Enabled(kCheckCopies) && validate(ctx);
   OpBatch batch;
   if (data.state.history_tracked) batch = make_ops();
   skip |= ValidateHostOps(ctx, batch, function);
-  // Skipped by the app's callback: the copy did not happen (VK_ERROR_VALIDATION_FAILED_EXT, as the Khronos
-  // layer returns).
-  if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
+  // Skipped by the app's callback, or withheld by protect mode: the copy did not happen.
+  if (skip) return WithholdHostCommand(data, function, data.device, protect);
   const VkResult result = downcall();
   FinishHostOps(data.state, std::move(batch), deferred, result);
   return result;
@@ -43,9 +44,10 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureKHR(VkCommandBuffer comma
                                                            const VkCopyAccelerationStructureInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
+  const ProtectScope protect;
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyInfo(ctx, "vkCmdCopyAccelerationStructureKHR", commandBuffer, *pInfo)) {
-    return;
+    return WithholdRecordedCommand(*data, "vkCmdCopyAccelerationStructureKHR", commandBuffer, protect);
   }
   data->dispatch.CmdCopyAccelerationStructureKHR(commandBuffer, pInfo);
   if (pInfo) RecordCmdCopy(data->state, commandBuffer, *pInfo);
@@ -55,9 +57,10 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
     VkCommandBuffer commandBuffer, const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
+  const ProtectScope protect;
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyToMemoryInfo(ctx, "vkCmdCopyAccelerationStructureToMemoryKHR", commandBuffer, *pInfo)) {
-    return;
+    return WithholdRecordedCommand(*data, "vkCmdCopyAccelerationStructureToMemoryKHR", commandBuffer, protect);
   }
   data->dispatch.CmdCopyAccelerationStructureToMemoryKHR(commandBuffer, pInfo);
   // Post-record of the capture: the bytes just serialized, copied once the serialization executed (layer/capture),
@@ -70,9 +73,10 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
     VkCommandBuffer commandBuffer, const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
+  const ProtectScope protect;
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyMemoryToInfo(ctx, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, *pInfo)) {
-    return;
+    return WithholdRecordedCommand(*data, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, protect);
   }
   // Pre-record of the capture: the bytes the deserialization will read, copied just before it executes.
   const uint32_t captured = pInfo ? CaptureBlob(*data, commandBuffer, pInfo->src.deviceAddress, VK_NULL_HANDLE) : 0;
@@ -86,10 +90,12 @@ VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(
     uint32_t firstQuery) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
+  const char* function = "vkCmdWriteAccelerationStructuresPropertiesKHR";
+  const ProtectScope protect;
   if (ctx.Enabled(kCheckCopies) &&
-      ValidateWriteProperties(ctx, "vkCmdWriteAccelerationStructuresPropertiesKHR", commandBuffer,
-                              accelerationStructureCount, pAccelerationStructures, queryType, queryPool, firstQuery)) {
-    return;
+      ValidateWriteProperties(ctx, function, commandBuffer, accelerationStructureCount, pAccelerationStructures,
+                              queryType, queryPool, firstQuery)) {
+    return WithholdRecordedCommand(*data, function, commandBuffer, protect);
   }
   data->dispatch.CmdWriteAccelerationStructuresPropertiesKHR(commandBuffer, accelerationStructureCount,
                                                              pAccelerationStructures, queryType, queryPool, firstQuery);
@@ -138,6 +144,7 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
   DeviceData* data = GetDeviceData(device);
   const char* function = "vkWriteAccelerationStructuresPropertiesKHR";
   const CheckContext ctx = MakeCheckContext(*data);
+  const ProtectScope protect;
   bool skip = ctx.Enabled(kCheckCopies) &&
               ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount,
                                       pAccelerationStructures, queryType, VK_NULL_HANDLE, 0);
@@ -145,7 +152,7 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
     skip |= ValidateHostOps(ctx, HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType),
                             function);
   }
-  if (skip) return VK_ERROR_VALIDATION_FAILED_EXT;
+  if (skip) return WithholdHostCommand(*data, function, device, protect);
   const VkResult result = data->dispatch.WriteAccelerationStructuresPropertiesKHR(
       device, accelerationStructureCount, pAccelerationStructures, queryType, dataSize, pData, stride);
   if (result == VK_SUCCESS && queryType == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR) {

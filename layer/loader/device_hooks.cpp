@@ -3,6 +3,7 @@
 #include "footprint_report.h"
 #include "history_host.h"
 #include "layer_data.h"
+#include "protect_notices.h"
 #include "state_tracker.h"
 #include "vk_struct_chain.h"
 #include "vk_intercepts.h"
@@ -22,7 +23,10 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     data->capture_tracker.reset();
     data->capture_pool->Shutdown();  // before the device goes; recordings still holding slabs give them back later
   }
-  if (data) ReportHistorySummary(data->state, *data->reporter, device);
+  if (data) {
+    ReportProtectSummary(data->state, *data->reporter, device);
+    ReportHistorySummary(data->state, *data->reporter, device);
+  }
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
 }
 

@@ -36,6 +36,7 @@ ReportSettings ToReportSettings(const LayerSettings& s) {
   r.message_id_filter = s.message_id_filter;
   r.report_file = s.report_file;
   r.log_to_stderr = s.log_to_stderr;
+  r.protect = s.protect;
   return r;
 }
 

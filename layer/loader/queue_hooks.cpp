@@ -2,31 +2,56 @@
 // submission order and checked, each against what the operations before it left (HistorySubmission,
 // layer/state/submission.h; the rules: SubmitChecks, layer/checks/submit_checks.h). A finding whose callback
 // returns VK_TRUE keeps the whole submission from the driver, as the Khronos layer does, and its history
-// changes are undone; so are those of a submission the driver rejects.
+// changes are undone; so are those of a submission the driver rejects. In protect mode (withhold.h) so does any
+// error found at submission, and a submitted command buffer that lacks a command the layer withheld.
 #include "layer_data.h"
 #include "submission.h"
 #include "submit_checks.h"
 #include "vk_intercepts.h"
+#include "withhold.h"
 
 namespace asval::hooks {
 
 namespace {
 
+// Protect mode: true when a submitted command buffer holds a command the layer withheld (the first is named).
+template <typename ForEachCommandBuffer>
+bool WithholdMarkedCommandBuffers(DeviceData& data, VkQueue queue, ForEachCommandBuffer&& for_each_command_buffer) {
+  bool withheld = false;
+  for_each_command_buffer([&](VkCommandBuffer cb, const Location& loc) {
+    if (withheld) return;
+    if (const std::shared_ptr<const WithheldCommand> command = data.state.command_buffers.Withheld(cb)) {
+      withheld = true;
+      RecordWithheldSubmission(data.state);
+      ReportWithheldSubmission(MakeCheckContext(data), loc, queue, cb, *command);
+    }
+  });
+  return withheld;
+}
+
 // for_each_command_buffer(visit) calls visit(cb, location) for every submitted command buffer, in order.
 template <typename ForEachCommandBuffer, typename Downcall>
-VkResult Submit(DeviceData& data, VkQueue queue, VkFence fence, ForEachCommandBuffer&& for_each_command_buffer,
-                Downcall&& downcall) {
+VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence fence,
+                ForEachCommandBuffer&& for_each_command_buffer, Downcall&& downcall) {
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
+  if (data.reporter->protects() && WithholdMarkedCommandBuffers(data, queue, for_each_command_buffer)) {
+    return VK_ERROR_VALIDATION_FAILED_EXT;
+  }
   const CheckContext ctx = MakeCheckContext(data);
   HistorySubmission submission(data.state);
   SubmitChecks checks(ctx);
   for_each_command_buffer(
       [&](VkCommandBuffer cb, const Location& loc) { submission.Apply(cb, checks.For(cb, loc)); });
   submission.EndApply();
+  const ProtectScope protect;
   if (checks.ReportAll()) {
     submission.Undo();
+    if (protect.withheld()) {
+      RecordWithheldSubmission(data.state);
+      ReportWithheldSubmission(ctx, function, queue, protect);
+    }
     return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   // Pre-record: the recordings whose captures run now count as pending before the device may write them.
@@ -56,7 +81,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, 
                                            VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
   return Submit(
-      *data, queue, fence,
+      *data, "vkQueueSubmit", queue, fence,
       [&](auto&& visit) {
         const Location root("vkQueueSubmit");
         for (uint32_t i = 0; i < submitCount; ++i) {
@@ -73,7 +98,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t submitCount,
                                             VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
   return Submit(
-      *data, queue, fence,
+      *data, "vkQueueSubmit2", queue, fence,
       [&](auto&& visit) {
         const Location root("vkQueueSubmit2");
         for (uint32_t i = 0; i < submitCount; ++i) {

@@ -8,6 +8,7 @@
 #include <new>
 #include <nlohmann/json.hpp>
 
+#include "protect_scope.h"
 #include "vk_enum_string.h"
 #include "vuid_table.h"
 
@@ -124,16 +125,37 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
 }
 
 void Reporter::ReportOrThrow(Severity severity, std::string_view vuid_in, const Location& loc,
-                             std::initializer_list<ReportObject> objects, std::string_view message, bool* skip_out) {
-  bool& skip = *skip_out;
+                             std::initializer_list<ReportObject> objects, std::string_view message, bool* skip) {
   if (!SeverityEnabled(severity)) return;
   const std::string_view vuid = NewestVuid(vuid_in);
   const uint32_t hash = MessageIdHash(vuid);
   if (filter_.Mutes(vuid, hash)) return;
+  if (settings_.protect && severity == Severity::kError) {
+    *skip = true;  // before anything that may throw
+    ProtectScope::NoteError(vuid, loc);
+  }
   bool last = false;
   if (!CountDuplicate(hash, &last)) return;
   CounterFor(severity).fetch_add(1, std::memory_order_relaxed);
+  Deliver(severity, vuid, hash, last, loc, objects, message, skip);
+}
 
+void Reporter::ReportLayerAction(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
+                                 std::string_view message) {
+  try {
+    const uint32_t hash = MessageIdHash(id);
+    if (filter_.Mutes(id, hash)) return;
+    CounterFor(Severity::kInfo).fetch_add(1, std::memory_order_relaxed);
+    bool skip_ignored = false;
+    Deliver(Severity::kInfo, id, hash, /*last=*/false, loc, objects, message, &skip_ignored);
+  } catch (const std::bad_alloc&) {
+    reports_lost_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void Reporter::Deliver(Severity severity, std::string_view vuid, uint32_t hash, bool last, const Location& loc,
+                       std::initializer_list<ReportObject> objects, std::string_view message, bool* skip_out) {
+  bool& skip = *skip_out;
   const VuidInfo* info = FindVuid(vuid);
   const std::string_view spec_text = info ? std::string_view(info->spec_text) : std::string_view();
   const std::string path = loc.Path();

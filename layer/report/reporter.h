@@ -32,6 +32,9 @@ struct ReportSettings {
   std::vector<std::string> message_id_filter;
   std::string report_file;                // JSON lines; empty = none
   bool log_to_stderr = false;             // also print when the app has a messenger
+  // Protect mode (protect_scope.h): every error that passes the severity filter and the mute list makes Report
+  // return true, also past the duplicate limit, so that the call that broke a rule never reaches the driver.
+  bool protect = false;
 };
 
 struct ReportObject {
@@ -60,10 +63,18 @@ class Reporter {
 
   void SetObjectName(uint64_t handle, const char* name);  // null or empty name forgets it
 
-  // Reports one finding. vuid may be an older spelling: the newest is reported. Returns true when a
-  // messenger callback returned VK_TRUE, i.e. the app asks the layer not to pass the call down.
+  // Reports one finding. vuid may be an older spelling: the newest is reported. Returns true when the call must
+  // not be passed down: a messenger callback returned VK_TRUE (the app asks the layer to skip it), or, in protect
+  // mode, the finding is an error (noted in the thread's ProtectScope, protect_scope.h).
   bool Report(Severity severity, std::string_view vuid, const Location& loc,
               std::initializer_list<ReportObject> objects, std::string_view message);
+
+  // Reports what the layer itself did to the app's call (protect mode withheld it): an information message that
+  // report_flags and the duplicate limit do not hide, since each withheld call is named once and a CI run must see
+  // why its app failed; the mute list still applies. Never asks to skip.
+  void ReportLayerAction(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
+                         std::string_view message);
+  bool protects() const { return settings_.protect; }
 
   // Findings delivered so far (after filters and limits), by severity, for summaries and tests.
   uint64_t ErrorCount() const { return error_count_.load(std::memory_order_relaxed); }
@@ -88,6 +99,10 @@ class Reporter {
   // Report's body; *skip is set as soon as a callback asks to skip, so that it stands if a later step throws.
   void ReportOrThrow(Severity severity, std::string_view vuid, const Location& loc,
                      std::initializer_list<ReportObject> objects, std::string_view message, bool* skip);
+  // Builds the text and delivers it (messengers, stderr, JSON): what is left of a report after the filters.
+  // `last`: this is the last message the duplicate limit lets through for its id.
+  void Deliver(Severity severity, std::string_view vuid, uint32_t hash, bool last, const Location& loc,
+               std::initializer_list<ReportObject> objects, std::string_view message, bool* skip);
   bool SeverityEnabled(Severity s) const;
   // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
   bool CountDuplicate(uint32_t hash, bool* last);

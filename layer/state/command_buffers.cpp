@@ -34,6 +34,7 @@ void CommandBufferState::Reset() {
   {
     std::lock_guard<std::mutex> lock(published_mutex_);
     old.swap(published_);
+    published_withheld_.reset();
   }
   // Nobody else can obtain it now; if nobody holds it either, its storage is ours to reuse.
   if (old && old.use_count() == 1) spare_ = std::const_pointer_cast<RecordedOps>(std::move(old));
@@ -66,6 +67,11 @@ bool CommandBufferState::Publish() {
   std::lock_guard<std::mutex> lock(published_mutex_);
   published_ = std::move(snapshot);
   return published;
+}
+
+void CommandBufferState::MarkWithheld(std::shared_ptr<const WithheldCommand> command) {
+  std::lock_guard<std::mutex> lock(published_mutex_);
+  if (!published_withheld_) published_withheld_ = std::move(command);
 }
 
 std::shared_ptr<CommandBufferMap::PoolState> CommandBufferMap::PoolOf(VkCommandPool pool) const {
@@ -156,6 +162,30 @@ void CommandBufferMap::Free(uint32_t count, const VkCommandBuffer* buffers) {
       }
     }
   }
+}
+
+bool CommandBufferMap::MarkWithheld(VkCommandBuffer cb, std::shared_ptr<const WithheldCommand> command) {
+  const std::shared_ptr<CommandBufferState> state = Find(cb);
+  if (!state) return false;
+  any_withheld_.store(true, std::memory_order_release);
+  state->MarkWithheld(std::move(command));
+  return true;
+}
+
+void CommandBufferMap::InheritWithheld(VkCommandBuffer primary, uint32_t count, const VkCommandBuffer* secondaries) {
+  if (!any_withheld_.load(std::memory_order_acquire) || !secondaries) return;
+  for (uint32_t i = 0; i < count; ++i) {
+    if (std::shared_ptr<const WithheldCommand> command = Withheld(secondaries[i])) {
+      MarkWithheld(primary, std::move(command));
+      return;
+    }
+  }
+}
+
+std::shared_ptr<const WithheldCommand> CommandBufferMap::Withheld(VkCommandBuffer cb) const {
+  if (!any_withheld_.load(std::memory_order_acquire)) return nullptr;
+  const std::shared_ptr<CommandBufferState> state = Find(cb);
+  return state ? state->Withheld() : nullptr;
 }
 
 }  // namespace asval

@@ -22,6 +22,7 @@
 #include "capture_log.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
+#include "protect_marks.h"
 
 namespace asval {
 
@@ -79,11 +80,21 @@ class CommandBufferState {
     std::lock_guard<std::mutex> lock(published_mutex_);
     return published_;
   }
+  // The command withheld from the last completed recording (or from the one in progress: a submission of a command
+  // buffer that is recording is invalid, and must not run either); null when none was.
+  std::shared_ptr<const WithheldCommand> Withheld() const {
+    std::lock_guard<std::mutex> lock(published_mutex_);
+    return published_withheld_;
+  }
+  // Protect mode withheld a command of the recording: the command buffer is marked at once (the first command
+  // is kept), until it is reset or begun again.
+  void MarkWithheld(std::shared_ptr<const WithheldCommand> command);
 
  private:
   std::array<uint32_t, kOpCommandCount> calls_{};
   mutable std::mutex published_mutex_;
   std::shared_ptr<const RecordedOps> published_;
+  std::shared_ptr<const WithheldCommand> published_withheld_;
   // A published snapshot nobody else holds any more, kept so that the next Publish reuses its storage: a
   // command buffer re-recorded every frame allocates nothing in the steady state.
   std::shared_ptr<RecordedOps> spare_;
@@ -104,6 +115,13 @@ class CommandBufferMap {
   }
   // vkEndCommandBuffer (after success): the recording becomes what submissions and primaries see.
   void End(VkCommandBuffer cb);
+  // Protect mode withheld a command recorded into cb (protect_marks.h). A command buffer the layer never saw
+  // allocated cannot be marked (false): its submissions are not withheld.
+  bool MarkWithheld(VkCommandBuffer cb, std::shared_ptr<const WithheldCommand> command);
+  // vkCmdExecuteCommands: a primary that executes a marked secondary is marked with the secondary's command.
+  void InheritWithheld(VkCommandBuffer primary, uint32_t count, const VkCommandBuffer* secondaries);
+  // The command that marks cb, or null. A single load while no command buffer of the device was ever marked.
+  std::shared_ptr<const WithheldCommand> Withheld(VkCommandBuffer cb) const;
   // Where allocation failures are counted (DeviceState's: failure_counters.h); set once, at device creation.
   void SetFailureCounters(FailureCounters* failures) { failures_ = failures; }
 
@@ -141,6 +159,8 @@ class CommandBufferMap {
   ConcurrentMap<VkCommandBuffer, std::shared_ptr<CommandBufferState>, 6> buffers_;
   ConcurrentMap<VkCommandPool, std::shared_ptr<PoolState>> pools_;
   std::atomic<bool> any_protected_pool_{false};
+  // Set at the first MarkWithheld: until then submissions look up no command buffer for protect mode.
+  std::atomic<bool> any_withheld_{false};
 };
 
 }  // namespace asval

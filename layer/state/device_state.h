@@ -17,6 +17,7 @@
 #include "host_mappings.h"
 #include "live_structure_addresses.h"
 #include "objects.h"
+#include "protect_marks.h"
 
 namespace asval {
 
@@ -86,6 +87,8 @@ class DeviceState {
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
+  // Calls protect mode kept from the driver (protect_marks.h).
+  ProtectCounters protect_counters;
 
   // A fresh id, unique on this device (BufferState::id).
   uint64_t NextObjectId() { return next_object_id_.fetch_add(1, std::memory_order_relaxed) + 1; }

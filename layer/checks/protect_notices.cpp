@@ -1,0 +1,75 @@
+#include "protect_notices.h"
+
+#include <fmt/format.h>
+
+#include <string>
+
+#include "history_findings.h"
+
+namespace asval {
+
+namespace {
+
+// "VUID-... (vkCmd...(): pInfos[0].mode)", or a plain statement when the finding's text could not be kept.
+std::string Cause(const std::string& vuid, const std::string& where) {
+  if (vuid.empty()) return "an error (its name could not be kept: the layer's allocation failed)";
+  return fmt::format("{} ({})", vuid, where);
+}
+
+}  // namespace
+
+void ReportWithheldCommand(const CheckContext& ctx, const char* function, VkCommandBuffer cb,
+                           const ProtectScope& cause, bool marked) {
+  const std::string then =
+      marked ? "The command buffer is marked: every submission of it is withheld (VK_ERROR_VALIDATION_FAILED_EXT) "
+               "until it is reset or begun again, since what it records next may depend on this command."
+             : "The layer never saw this command buffer allocated, so it cannot withhold its submissions.";
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb)},
+      fmt::format("protect: {} was not recorded (not passed down) because asval reported {}. {}", function,
+                  Cause(cause.vuid(), cause.where()), then));
+}
+
+void ReportWithheldHostCommand(const CheckContext& ctx, const char* function, VkDevice device,
+                               const ProtectScope& cause) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("protect: {} did not run (not passed down) and returned VK_ERROR_VALIDATION_FAILED_EXT because "
+                  "asval reported {}.",
+                  function, Cause(cause.vuid(), cause.where())));
+}
+
+void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, VkQueue queue, VkCommandBuffer cb,
+                              const WithheldCommand& command) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, cb_loc, {Obj(VK_OBJECT_TYPE_QUEUE, queue), Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb)},
+      fmt::format("protect: {} was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; "
+                  "its fence and semaphores are not signaled) because this command buffer lacks a command asval "
+                  "withheld when it was recorded: {}, for {}.",
+                  cb_loc.Function(), command.function, Cause(command.vuid, command.where)));
+}
+
+void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
+                              const ProtectScope& cause) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_QUEUE, queue)},
+      fmt::format("protect: {} was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; "
+                  "its fence and semaphores are not signaled; the build history is as before it) because asval "
+                  "reported {} in execution order.",
+                  function, Cause(cause.vuid(), cause.where())));
+}
+
+void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const ProtectCounters& c = state.protect_counters;
+  const uint64_t commands = c.commands_withheld.load(std::memory_order_relaxed);
+  const uint64_t submissions = c.submissions_withheld.load(std::memory_order_relaxed);
+  const uint64_t host = c.host_commands_withheld.load(std::memory_order_relaxed);
+  if (commands == 0 && submissions == 0 && host == 0) return;
+  reporter.ReportLayerAction(
+      kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("Protect mode kept from the driver: recorded_commands_withheld={} submissions_withheld={} "
+                  "host_commands_withheld={} (each named in an {} message).",
+                  commands, submissions, host, kProtectWithheldId));
+}
+
+}  // namespace asval

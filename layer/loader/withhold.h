@@ -1,0 +1,30 @@
+#pragma once
+// What a hook does with a call its validation said to skip (setting `protect`; layer/report/protect_scope.h). A skip
+// the app's callback asked for (VK_TRUE) is only a skip; one protect mode caused is withheld: a recorded command
+// marks its command buffer, so that no submission of it runs, and every withheld call is counted and named once.
+#include "layer_data.h"
+#include "protect_marks.h"
+#include "protect_notices.h"
+#include "protect_scope.h"
+
+namespace asval::hooks {
+
+// A recorded command that is not passed down.
+inline void WithholdRecordedCommand(DeviceData& data, const char* function, VkCommandBuffer cb,
+                                    const ProtectScope& protect) {
+  if (!protect.withheld()) return;
+  const bool marked = RecordWithheldCommand(data.state, cb, function, protect.vuid(), protect.where());
+  ReportWithheldCommand(MakeCheckContext(data), function, cb, protect, marked);
+}
+
+// A host command that does not run: VK_ERROR_VALIDATION_FAILED_EXT, what the Khronos layer returns for a skip.
+inline VkResult WithholdHostCommand(DeviceData& data, const char* function, VkDevice device,
+                                    const ProtectScope& protect) {
+  if (protect.withheld()) {
+    RecordWithheldHostCommand(data.state);
+    ReportWithheldHostCommand(MakeCheckContext(data), function, device, protect);
+  }
+  return VK_ERROR_VALIDATION_FAILED_EXT;
+}
+
+}  // namespace asval::hooks
