@@ -26,7 +26,7 @@ void ReportWithheldCommand(const CheckContext& ctx, const char* function, VkComm
              : "The layer never saw this command buffer allocated, so it cannot withhold its submissions.";
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb)},
-      fmt::format("protect: {} was not recorded (not passed down) because asval reported {}. {}", function,
+      fmt::format("protect: this command was not passed down (not recorded) because asval reported {}. {}",
                   Cause(cause.vuid(), cause.where()), then));
 }
 
@@ -34,29 +34,29 @@ void ReportWithheldHostCommand(const CheckContext& ctx, const char* function, Vk
                                const ProtectScope& cause) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
-      fmt::format("protect: {} did not run (not passed down) and returned VK_ERROR_VALIDATION_FAILED_EXT because "
-                  "asval reported {}.",
-                  function, Cause(cause.vuid(), cause.where())));
+      fmt::format("protect: this command was not passed down (it did not run) and returned "
+                  "VK_ERROR_VALIDATION_FAILED_EXT because asval reported {}.",
+                  Cause(cause.vuid(), cause.where())));
 }
 
 void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, VkQueue queue, VkCommandBuffer cb,
                               const WithheldCommand& command) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, cb_loc, {Obj(VK_OBJECT_TYPE_QUEUE, queue), Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb)},
-      fmt::format("protect: {} was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; "
-                  "its fence and semaphores are not signaled) because this command buffer lacks a command asval "
-                  "withheld when it was recorded: {}, for {}.",
-                  cb_loc.Function(), command.function, Cause(command.vuid, command.where)));
+      fmt::format("lacks a command asval withheld when it was recorded ({}, for {}). protect: the submission was "
+                  "not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; its fence and "
+                  "semaphores are not signaled).",
+                  command.function, Cause(command.vuid, command.where)));
 }
 
 void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
                               const ProtectScope& cause) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_QUEUE, queue)},
-      fmt::format("protect: {} was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; "
-                  "its fence and semaphores are not signaled; the build history is as before it) because asval "
-                  "reported {} in execution order.",
-                  function, Cause(cause.vuid(), cause.where())));
+      fmt::format("protect: the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT "
+                  "(nothing of it ran; its fence and semaphores are not signaled; the build history is as before "
+                  "it) because asval reported {} in execution order.",
+                  Cause(cause.vuid(), cause.where())));
 }
 
 void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
