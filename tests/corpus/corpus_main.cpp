@@ -3,6 +3,7 @@
 // the process half-way (an invalid call that no layer stopped may bring the driver down): what was reported
 // before is kept.
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -52,7 +53,9 @@ void List() {
 }
 
 // Errors return VK_TRUE: whichever layer reports the fault keeps the call from the driver, as an app that stops
-// on validation errors would (both layers honour it).
+// on validation errors would (both layers honour it). ASVAL_CORPUS_MESSENGER=report-only makes it return VK_FALSE
+// always, as a CI app's messenger (or none) does: only asval's protect mode then keeps a fault from the driver
+// (scripts/device_protect.sh).
 VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
   const bool error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
@@ -61,7 +64,11 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT seve
   std::printf("{\"severity\": \"%s\", \"id\": %s, \"text\": %s}\n", error ? "error" : "warning",
               Json(data->pMessageIdName ? data->pMessageIdName : "").c_str(), Json(text).c_str());
   std::fflush(stdout);
-  return error ? VK_TRUE : VK_FALSE;
+  static const bool report_only = [] {
+    const char* mode = std::getenv("ASVAL_CORPUS_MESSENGER");
+    return mode && std::strcmp(mode, "report-only") == 0;
+  }();
+  return error && !report_only ? VK_TRUE : VK_FALSE;
 }
 
 int Run(const Case& c) {
