@@ -59,17 +59,37 @@ void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQ
                   Cause(cause.vuid(), cause.where())));
 }
 
+void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(cause.function()), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("protect: asval reported {} when the work that broke the rule completed (execution-time "
+                  "capture): that work already ran, and what it built may be corrupt. Every later submission on this "
+                  "device is withheld (VK_ERROR_VALIDATION_FAILED_EXT), so that nothing uses it.",
+                  Cause(cause.vuid(), cause.where())));
+}
+
+void ReportHaltedSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
+                            const WithheldCommand& cause) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_QUEUE, queue)},
+      fmt::format("protect: the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing "
+                  "of it ran; its fence and semaphores are not signaled) because an earlier submission broke a rule "
+                  "found when it completed: {}. Every submission on this device since is withheld.",
+                  Cause(cause.vuid, cause.where)));
+}
+
 void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
   const ProtectCounters& c = state.protect_counters;
   const uint64_t commands = c.commands_withheld.load(std::memory_order_relaxed);
   const uint64_t submissions = c.submissions_withheld.load(std::memory_order_relaxed);
   const uint64_t host = c.host_commands_withheld.load(std::memory_order_relaxed);
-  if (commands == 0 && submissions == 0 && host == 0) return;
+  const bool halted = state.protect_halt.Cause() != nullptr;
+  if (commands == 0 && submissions == 0 && host == 0 && !halted) return;
   reporter.ReportLayerAction(
       kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
       fmt::format("Protect mode kept from the driver: recorded_commands_withheld={} submissions_withheld={} "
-                  "host_commands_withheld={} (each named in an {} message).",
-                  commands, submissions, host, kProtectWithheldId));
+                  "host_commands_withheld={} submissions_halted_by_completion_error={} (each named in an {} message).",
+                  commands, submissions, host, halted ? 1 : 0, kProtectWithheldId));
 }
 
 }  // namespace asval

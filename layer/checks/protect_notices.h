@@ -27,6 +27,11 @@ void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, V
 // A submission not passed down because of an error found when it was submitted (in execution order).
 void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
                               const ProtectScope& cause);
+// An error judged at completion (execution-time capture) halted submissions: every later one is withheld.
+void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause);
+// A submission not passed down because submissions are halted (SubmissionHalt, protect_marks.h).
+void ReportHaltedSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
+                            const WithheldCommand& cause);
 // ASVAL-History-Summary's protect line at vkDestroyDevice; none when nothing was withheld.
 void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice device);
 

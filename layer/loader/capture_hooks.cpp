@@ -12,6 +12,7 @@
 #include "layer_data.h"
 #include "serialized_capture.h"
 #include "vk_intercepts.h"
+#include "withhold.h"
 
 namespace asval {
 
@@ -21,6 +22,8 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   const LayerSettings& settings = data.instance->settings;
   const uint32_t warnings = settings.capture_warnings;
   const uint32_t spacing_permille = warnings & kCaptureWarnFloatSpacing ? settings.capture_float_spacing_permille : 0;
+  // Protect mode: an error judged now is about work that already ran; later submissions are withheld instead.
+  const ProtectScope protect;
   data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
     for (const std::shared_ptr<BuildActivity>& activity : done.fills) {
       activity->Fill(spacing_permille);
@@ -37,6 +40,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
     // (layer/state writes the history; it takes the store's lock itself, under the processing lock held here).
     CompleteSerializedCaptures(data.state.history.store, data.state.capture_counters, done);
   });
+  hooks::HaltSubmissionsAfter(data, protect);
 }
 
 namespace {

@@ -36,8 +36,13 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
-  if (data.reporter->protects() && WithholdMarkedCommandBuffers(data, queue, for_each_command_buffer)) {
-    return VK_ERROR_VALIDATION_FAILED_EXT;
+  if (data.reporter->protects()) {
+    if (const std::shared_ptr<const WithheldCommand> halt = data.state.protect_halt.Cause()) {
+      RecordWithheldSubmission(data.state);
+      ReportHaltedSubmission(MakeCheckContext(data), function, queue, *halt);
+      return VK_ERROR_VALIDATION_FAILED_EXT;
+    }
+    if (WithholdMarkedCommandBuffers(data, queue, for_each_command_buffer)) return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   const CheckContext ctx = MakeCheckContext(data);
   HistorySubmission submission(data.state);

@@ -2,6 +2,7 @@
 // What a hook does with a call its validation said to skip (setting `protect`; layer/report/protect_scope.h). A skip
 // the app's callback asked for (VK_TRUE) is only a skip; one protect mode caused is withheld: a recorded command
 // marks its command buffer, so that no submission of it runs, and every withheld call is counted and named once.
+// HaltSubmissionsAfter is protect mode for errors judged at completion, when the work already ran.
 #include "layer_data.h"
 #include "protect_marks.h"
 #include "protect_notices.h"
@@ -25,6 +26,14 @@ inline VkResult WithholdHostCommand(DeviceData& data, const char* function, VkDe
     ReportWithheldHostCommand(MakeCheckContext(data), function, device, protect);
   }
   return VK_ERROR_VALIDATION_FAILED_EXT;
+}
+
+// Errors judged at completion (execution-time capture) while `protect` was open: the work already ran, so every
+// later submission on the device is withheld (named once here, and in each submission's notice).
+inline void HaltSubmissionsAfter(DeviceData& data, const ProtectScope& protect) {
+  if (!protect.withheld() || data.state.protect_halt.Cause()) return;
+  RecordSubmissionHalt(data.state, protect.function(), protect.vuid(), protect.where());
+  ReportSubmissionHalt(MakeCheckContext(data), data.device, protect);
 }
 
 }  // namespace asval::hooks

@@ -14,6 +14,7 @@ void ProtectScope::NoteError(std::string_view vuid, const Location& loc) {
   ProtectScope* scope = t_current;
   if (!scope || scope->withheld_) return;
   scope->withheld_ = true;  // first, so that it stands if the text below cannot be made
+  scope->function_ = loc.Function();
   scope->vuid_.assign(vuid);
   std::string path = loc.Path();
   scope->where_.assign(loc.Function()).append("()");

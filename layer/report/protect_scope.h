@@ -27,6 +27,8 @@ class ProtectScope {
   // pInfos[0].scratchData"). Empty when the text could not be kept (allocation failure): still withheld.
   const std::string& vuid() const { return vuid_; }
   const std::string& where() const { return where_; }
+  // The command the error is about, e.g. "vkCmdBuildAccelerationStructuresKHR" (its Location's root); "" before.
+  const char* function() const { return function_; }
 
   // The reporter's side: an error protect mode acts on. The first is kept by the current scope; without one (a
   // report outside any protecting hook) nothing is kept. May throw std::bad_alloc after marking the scope.
@@ -35,6 +37,7 @@ class ProtectScope {
  private:
   ProtectScope* outer_;
   bool withheld_ = false;
+  const char* function_ = "";
   std::string vuid_;
   std::string where_;
 };

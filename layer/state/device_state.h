@@ -87,8 +87,10 @@ class DeviceState {
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
-  // Calls protect mode kept from the driver (protect_marks.h).
+  // Calls protect mode kept from the driver, and whether an error judged at completion halted submissions
+  // (protect_marks.h).
   ProtectCounters protect_counters;
+  SubmissionHalt protect_halt;
 
   // A fresh id, unique on this device (BufferState::id).
   uint64_t NextObjectId() { return next_object_id_.fetch_add(1, std::memory_order_relaxed) + 1; }

@@ -15,20 +15,29 @@ std::shared_ptr<const WithheldCommand> UnnamedCommand() {
   return std::shared_ptr<const WithheldCommand>(std::shared_ptr<const WithheldCommand>(), &unnamed);
 }
 
+// The record of a withheld command; the unnamed one when it cannot be made.
+std::shared_ptr<const WithheldCommand> MakeWithheld(DeviceState& state, std::string_view function,
+                                                    std::string_view vuid, std::string_view where) {
+  try {
+    return std::make_shared<const WithheldCommand>(
+        WithheldCommand{std::string(function), std::string(vuid), std::string(where)});
+  } catch (const std::bad_alloc&) {
+    state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    return UnnamedCommand();
+  }
+}
+
 }  // namespace
 
 bool RecordWithheldCommand(DeviceState& state, VkCommandBuffer cb, std::string_view function, std::string_view vuid,
                            std::string_view where) {
   state.protect_counters.commands_withheld.fetch_add(1, std::memory_order_relaxed);
-  std::shared_ptr<const WithheldCommand> command;
-  try {
-    command = std::make_shared<const WithheldCommand>(
-        WithheldCommand{std::string(function), std::string(vuid), std::string(where)});
-  } catch (const std::bad_alloc&) {
-    state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
-    command = UnnamedCommand();
-  }
-  return state.command_buffers.MarkWithheld(cb, std::move(command));
+  return state.command_buffers.MarkWithheld(cb, MakeWithheld(state, function, vuid, where));
+}
+
+void RecordSubmissionHalt(DeviceState& state, std::string_view function, std::string_view vuid,
+                          std::string_view where) {
+  state.protect_halt.Set(MakeWithheld(state, function, vuid, where));
 }
 
 void RecordWithheldSubmission(DeviceState& state) {

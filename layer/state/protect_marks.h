@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -18,6 +20,30 @@ struct WithheldCommand {
   std::string function;  // e.g. "vkCmdBuildAccelerationStructuresKHR"
   std::string vuid;      // the error that withheld it (newest spelling)
   std::string where;     // where that error was found, e.g. "vkCmdBuildAccelerationStructuresKHR(): pInfos[0].mode"
+};
+
+// An error judged when a submission completed (execution-time capture): the work that broke the rule already ran,
+// and what it built may be corrupt, so every later submission on the device is withheld (a trace of such a
+// structure is what hangs a GPU). Set once; the first such finding is kept and named.
+class SubmissionHalt {
+ public:
+  void Set(std::shared_ptr<const WithheldCommand> cause) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (cause_) return;
+    cause_ = std::move(cause);
+    halted_.store(true, std::memory_order_release);
+  }
+  // The finding that halted submissions, or null: a single load while none did.
+  std::shared_ptr<const WithheldCommand> Cause() const {
+    if (!halted_.load(std::memory_order_acquire)) return nullptr;
+    std::lock_guard<std::mutex> lock(mutex_);
+    return cause_;
+  }
+
+ private:
+  std::atomic<bool> halted_{false};
+  mutable std::mutex mutex_;
+  std::shared_ptr<const WithheldCommand> cause_;
 };
 
 // Counted in ASVAL-History-Summary at vkDestroyDevice (layer/checks/protect_notices.h).
@@ -34,6 +60,10 @@ class DeviceState;
 // allocated). An allocation failure marks it with an unnamed command.
 bool RecordWithheldCommand(DeviceState& state, VkCommandBuffer cb, std::string_view function, std::string_view vuid,
                            std::string_view where);
+// Protect mode: an error was judged at completion (`function` names the command whose completion showed it, e.g.
+// "vkCmdBuildAccelerationStructuresKHR"); every later submission on the device is withheld.
+void RecordSubmissionHalt(DeviceState& state, std::string_view function, std::string_view vuid,
+                          std::string_view where);
 // A queue submission, or a host command, protect mode kept from the driver.
 void RecordWithheldSubmission(DeviceState& state);
 void RecordWithheldHostCommand(DeviceState& state);
