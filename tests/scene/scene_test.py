@@ -3,9 +3,17 @@
 
 Modes (the environment selects the driver and the layers, see tests/scene/CMakeLists.txt):
   clean           the scene runs and no layer reports anything (no message, empty asval report)
-  fault NAME      if asval checks NAME's VUID (scripts/checks/*.json says "checked"), the run reports exactly
-                  that VUID as an error and no other error; otherwise the run must still finish cleanly, and
-                  the test is skipped (exit 77) until the check lands
+  fault NAME      the scene runs with asval's protect mode on (it chains the setting itself) and exits 0. If asval
+                  checks NAME's VUID (scripts/checks/*.json says "checked"), the run reports exactly that VUID as
+                  an error and no other error, and a fault found at record time or at submission never reaches
+                  the driver: asval's ASVAL-Protect-Withheld notices name it (the command and its submission, or
+                  the submission), the scene saw the submission fail with VK_ERROR_VALIDATION_FAILED_EXT, and the
+                  protect summary counts them; a fault found at execution runs (no notice). Otherwise the run
+                  must still finish, and the test is skipped (exit 77) until the check lands
+  unprotected     every record-time (hang-prone) fault, run without any layer and then under asval with protect
+                  forced off (VK_ASVAL_AS_VALIDATION_PROTECT=false wins over the scene's chained setting): no
+                  ASVAL-Protect-Withheld notice arrives, so the scene never submits the command buffer, says so
+                  and exits 0 (under asval the VUID is still reported)
   image           the PNG rendered without any layer and with asval are byte for byte identical
   vuids           every fault's VUID is a VUID of the specification chapter under its newest name
 """
@@ -19,6 +27,8 @@ import tempfile
 
 SKIP = 77
 LAYER = "VK_LAYER_ASVAL_as_validation"
+NOTICE = "ASVAL-Protect-Withheld"
+SUMMARY = "ASVAL-History-Summary"
 REPORT_ENV = "VK_ASVAL_AS_VALIDATION_REPORT_FILE"
 
 
@@ -49,12 +59,13 @@ def read_report(path):
 
 
 def list_faults(scene):
+    """{name: (vuid, when)}, when being record, submit or execution."""
     out = subprocess.run([scene, "--list-faults"], stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
     faults = {}
     for line in out.splitlines():
         if line.strip() and not line.startswith("#"):
-            name, vuid = line.split()[:2]
-            faults[name] = vuid
+            name, vuid, when = line.split()[:3]
+            faults[name] = (vuid, when)
     return faults
 
 
@@ -88,16 +99,41 @@ def mode_clean(opts):
     print("PASS: no validation message")
 
 
+def check_protected(name, vuid, when, out, lines):
+    """A fault found at record time or at submission: asval kept it from the driver and said so."""
+    notices = [l for l in lines if l.get("vuid") == NOTICE]
+    if not notices:
+        fail("no %s notice in asval's report" % NOTICE)
+    for n in notices:
+        if n.get("severity") != "info" or vuid not in n.get("message", ""):
+            fail("a %s notice that is not an information message naming %s: %s" % (NOTICE, vuid, n))
+    functions = [n["function"] for n in notices]
+    # The recorded command (record faults), then the submission of its command buffer, or the submission alone.
+    expected = ["vkCmd", "vkQueueSubmit"] if when == "record" else ["vkQueueSubmit"]
+    if len(functions) != len(expected) or not all(f.startswith(e) for f, e in zip(functions, expected)):
+        fail("expected %s notices for %s, got them for %s" % (NOTICE, " then ".join(expected), functions))
+    if "fault %s: %d %s notice(s)" % (name, len(notices), NOTICE) not in out:
+        fail("the scene's messenger did not receive the %d %s notice(s) of the report" % (len(notices), NOTICE))
+    if when == "record" and "fault: asval withheld the command while recording; submitting its buffer" not in out:
+        fail("the scene did not see the recorded command withheld")
+    if "fault: asval withheld the submission (VK_ERROR_VALIDATION_FAILED_EXT)" not in out:
+        fail("the scene did not see its submission fail with VK_ERROR_VALIDATION_FAILED_EXT")
+    summary = "Protect mode kept from the driver: recorded_commands_withheld=%d submissions_withheld=1 " \
+              "host_commands_withheld=0" % (1 if when == "record" else 0)
+    if not any(l.get("vuid") == SUMMARY and summary in l.get("message", "") for l in lines):
+        fail("asval's report lacks the summary line '%s'" % summary)
+
+
 def mode_fault(opts):
     faults = list_faults(opts.scene)
     if opts.name not in faults:
         fail("asval_scene --list-faults has no fault %s" % opts.name)
-    vuid = faults[opts.name]
+    vuid, when = faults[opts.name]
     exists = vuid in checked_vuids(opts.checks)
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "report.jsonl")
         args = ["--frames", "2", "--instances", "300", "--size", "64x64", "--inject", opts.name]
-        out = run_scene(opts.scene, args, os.environ, report)
+        out = run_scene(opts.scene, args, os.environ, report)  # exit status 0, or the test fails
         lines = read_report(report)
     errors = sorted({l["vuid"] for l in lines if l.get("severity") == "error"})
     if not exists:
@@ -108,7 +144,39 @@ def mode_fault(opts):
         fail("the scene's messenger did not receive %s" % vuid)
     if errors != [vuid]:
         fail("expected exactly the error %s in asval's report, got %s" % (vuid, errors))
-    print("PASS: %s reported %s" % (opts.name, vuid))
+    if when in ("record", "submit"):
+        check_protected(opts.name, vuid, when, out, lines)
+        print("PASS: %s reported %s; protect mode withheld it (%s)" % (opts.name, vuid, when))
+    else:
+        # Judged once the work completed: it ran, so neither the command nor its submission was withheld.
+        if "fault: asval withheld" in out:
+            fail("a fault found at execution was withheld before it ran")
+        if any(l.get("vuid") == NOTICE and "not passed down" in l.get("message", "") for l in lines):
+            fail("a fault found at execution, yet asval announced a command or submission it did not pass down")
+        print("PASS: %s reported %s at execution (it ran: nothing to withhold before)" % (opts.name, vuid))
+
+
+def mode_unprotected(opts):
+    withheld_by_scene = "fault: no %s notice while recording; the command buffer is withheld by the scene" % NOTICE
+    plain_env = dict(os.environ)
+    plain_env.pop("VK_INSTANCE_LAYERS", None)
+    off_env = dict(os.environ)
+    off_env["VK_ASVAL_AS_VALIDATION_PROTECT"] = "false"
+    record_faults = sorted(n for n, (_, when) in list_faults(opts.scene).items() if when == "record")
+    if not record_faults:
+        fail("asval_scene --list-faults lists no record-time fault")
+    for name in record_faults:
+        vuid = list_faults(opts.scene)[name][0]
+        args = ["--frames", "2", "--instances", "300", "--size", "64x64", "--inject", name]
+        for label, env in (("without asval", plain_env), ("asval, protect off", off_env)):
+            out = run_scene(opts.scene, args, env)  # exit status 0, or the test fails
+            if withheld_by_scene not in out or "fault: asval withheld" in out:
+                fail("%s (%s): the scene did not keep the command buffer to itself" % (name, label))
+            if "fault %s: 0 %s notice(s)" % (name, NOTICE) not in out:
+                fail("%s (%s): a %s notice arrived" % (name, label, NOTICE))
+            if env is off_env and "fault %s: expected %s: reported" % (name, vuid) not in out:
+                fail("%s (asval, protect off): %s was not reported" % (name, vuid))
+    print("PASS: %d record-time faults never submitted without protect mode" % len(record_faults))
 
 
 def mode_image(opts):
@@ -137,7 +205,7 @@ def mode_vuids(opts):
         table = json.load(f)
     chapter = set(table["chapter_vuids"])
     older = {old: new for new, olds in table["aliases"].items() for old in olds}
-    for name, vuid in sorted(list_faults(opts.scene).items()):
+    for name, (vuid, _) in sorted(list_faults(opts.scene).items()):
         if vuid not in chapter:
             fail("%s: %s is not a VUID of the chapter" % (name, vuid))
         if vuid in older:
@@ -151,10 +219,11 @@ def main():
     parser.add_argument("--checks", help="scripts/checks (the registry of asval's checks)")
     parser.add_argument("--vuids", help="scripts/vuids_newer.json")
     parser.add_argument("--frames", type=int, default=4)
-    parser.add_argument("mode", choices=["clean", "fault", "image", "vuids"])
+    parser.add_argument("mode", choices=["clean", "fault", "unprotected", "image", "vuids"])
     parser.add_argument("name", nargs="?")
     opts = parser.parse_args()
-    {"clean": mode_clean, "fault": mode_fault, "image": mode_image, "vuids": mode_vuids}[opts.mode](opts)
+    {"clean": mode_clean, "fault": mode_fault, "unprotected": mode_unprotected, "image": mode_image,
+     "vuids": mode_vuids}[opts.mode](opts)
 
 
 if __name__ == "__main__":

@@ -6,21 +6,22 @@
 
 namespace scene {
 
-VkDebugUtilsMessengerCreateInfoEXT Findings::CreateInfo() {
+VkDebugUtilsMessengerCreateInfoEXT Findings::CreateInfo(bool notices) {
   VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  if (notices) info.messageSeverity |= VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT;
   info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
   info.pfnUserCallback = &Findings::Callback;
   info.pUserData = this;
   return info;
 }
 
-void Findings::Attach(VkInstance instance) {
+void Findings::Attach(VkInstance instance, bool notices) {
   instance_ = instance;
   auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
       vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
   if (!create) return;  // no VK_EXT_debug_utils: layers print to stderr instead
-  const VkDebugUtilsMessengerCreateInfoEXT info = CreateInfo();
+  const VkDebugUtilsMessengerCreateInfoEXT info = CreateInfo(notices);
   Check(create(instance, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
 }
 
@@ -42,6 +43,16 @@ uint32_t Findings::warnings() const {
   return warnings_;
 }
 
+uint32_t Findings::infos() const {
+  std::lock_guard lock(mutex_);
+  return infos_;
+}
+
+uint32_t Findings::withheld_notices() const {
+  std::lock_guard lock(mutex_);
+  return withheld_notices_;
+}
+
 std::vector<Finding> Findings::all() const {
   std::lock_guard lock(mutex_);
   return all_;
@@ -53,14 +64,22 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Findings::Callback(VkDebugUtilsMessageSeverityFla
   auto* self = static_cast<Findings*>(user);
   Finding f;
   f.error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  f.info = severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
   f.vuid = data->pMessageIdName ? data->pMessageIdName : "(no id)";
   f.message = data->pMessage ? data->pMessage : "";
   std::lock_guard lock(self->mutex_);
-  (f.error ? self->errors_ : self->warnings_) += 1;
-  std::printf("finding: %s %s\n%s\n", f.error ? "error" : "warning", f.vuid.c_str(), f.message.c_str());
+  if (f.info) {
+    self->infos_ += 1;
+    if (f.vuid == kWithheldNoticeId) self->withheld_notices_ += 1;
+  } else {
+    (f.error ? self->errors_ : self->warnings_) += 1;
+  }
+  std::printf("finding: %s %s\n%s\n", f.error ? "error" : f.info ? "info" : "warning", f.vuid.c_str(),
+              f.message.c_str());
   std::fflush(stdout);  // keep the scene's own lines and the messages in order
   self->all_.push_back(std::move(f));
-  return severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? VK_TRUE : VK_FALSE;
+  // Never a skip: an application without a test framework lets every call through; protect mode decides.
+  return VK_FALSE;
 }
 
 }  // namespace scene

@@ -47,23 +47,24 @@ class Injector {
   void Run();
 
  private:
-  // Records one command buffer. Faults marked `withheld` are submitted only when an error was reported while
-  // recording (the messenger returned VK_TRUE, so the layer dropped the call and the buffer is harmless).
+  // Records one command buffer and submits it. A fault marked `withheld` is submitted only when asval announced,
+  // while it was recorded, that it withheld the invalid command (protect mode: ASVAL-Protect-Withheld); the
+  // command buffer is then marked and asval withholds its submission too. Without that notice (no asval, or
+  // protect off) the command would reach the driver, so the scene never submits it.
   void RecordAndSubmit(const std::function<void(VkCommandBuffer)>& record) {
+    const uint32_t notices_before = s_.findings.withheld_notices();
     VkCommandBuffer cb = Record(record);
-    const bool caught = s_.findings.errors() > errors_before_record_;
-    if (fault_.withheld && !caught) {
-      std::printf("fault: nothing was reported while recording; the command buffer is withheld (executing it could "
-                  "corrupt memory or hang the device)\n");
+    if (fault_.withheld && s_.findings.withheld_notices() == notices_before) {
+      std::printf("fault: no %s notice while recording; the command buffer is withheld by the scene (executing it "
+                  "could corrupt memory or hang the device)\n", kWithheldNoticeId);
     } else {
-      if (caught) std::printf("fault: reported while recording; the layer dropped the call, the rest is submitted\n");
+      if (fault_.withheld) std::printf("fault: asval withheld the command while recording; submitting its buffer\n");
       Submit({cb});
     }
     gpu_.FreeCommandBuffer(cb);
   }
 
   VkCommandBuffer Record(const std::function<void(VkCommandBuffer)>& record) {
-    errors_before_record_ = s_.findings.errors();
     VkCommandBuffer cb = gpu_.AllocateCommandBuffer();
     gpu_.Begin(cb, VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
     record(cb);
@@ -71,13 +72,15 @@ class Injector {
     return cb;
   }
 
-  // A layer that finds a submission invalid may skip it (the messenger returned VK_TRUE) and return an error.
+  // In protect mode asval withholds a submission that holds a withheld command or breaks a rule in execution
+  // order: it returns VK_ERROR_VALIDATION_FAILED_EXT and announces it. That is the expected outcome of a fault,
+  // and the scene goes on; any other failure is the scene's own.
   void Submit(std::initializer_list<VkCommandBuffer> cbs) {
-    const uint32_t before = s_.findings.errors();
+    const uint32_t notices_before = s_.findings.withheld_notices();
     const VkResult result = gpu_.SubmitAndWait(cbs);
     if (result == VK_SUCCESS) return;
-    if (s_.findings.errors() > before) {
-      std::printf("fault: the submission was skipped by the layer (VkResult %d)\n", static_cast<int>(result));
+    if (result == VK_ERROR_VALIDATION_FAILED_EXT && s_.findings.withheld_notices() > notices_before) {
+      std::printf("fault: asval withheld the submission (VK_ERROR_VALIDATION_FAILED_EXT)\n");
       return;
     }
     Check(result, "fault: vkQueueSubmit");
@@ -108,7 +111,6 @@ class Injector {
   const FaultInfo& fault_;
   const uint32_t parity_;  // of the next frame: its vertex and instance buffers are free to use
   Scratchpad pad_;
-  uint32_t errors_before_record_ = 0;
 };
 
 void Injector::Run() {

@@ -12,6 +12,7 @@
 #include "gpu.h"
 #include "inject.h"
 #include "options.h"
+#include "protect_settings.h"
 #include "scene.h"
 #include "vkkit.h"
 
@@ -34,12 +35,15 @@ int Run(const scene::SceneOptions& options) {
   scene::Findings findings;
   {
     // The messenger is chained into the create info too, so messages of vkCreateInstance and
-    // vkDestroyInstance arrive. Layers come from the environment, as for any application.
-    const VkDebugUtilsMessengerCreateInfoEXT messenger = findings.CreateInfo();
+    // vkDestroyInstance arrive. Layers come from the environment, as for any application. A fault run also
+    // turns on asval's protect mode and listens to its notices; a plain run asks for nothing more.
+    const bool fault_run = options.fault != nullptr;
+    const VkDebugUtilsMessengerCreateInfoEXT messenger = findings.CreateInfo(fault_run);
+    const scene::ProtectSettings protect(&messenger);
     vkkit::InstanceOptions instance_options;
-    instance_options.pNext = &messenger;
+    instance_options.pNext = fault_run ? protect.chain() : &messenger;
     vkkit::Instance instance(instance_options);
-    findings.Attach(instance.handle());
+    findings.Attach(instance.handle(), fault_run);
     struct DetachFirst {  // the messenger goes before the instance, also when something throws
       scene::Findings& findings;
       ~DetachFirst() { findings.Detach(); }
@@ -72,6 +76,7 @@ int Run(const scene::SceneOptions& options) {
     bool reported = false;
     for (const scene::Finding& x : findings.all()) reported = reported || x.vuid == f.vuid;
     std::printf("fault %s: expected %s: %s\n", f.name, f.vuid, reported ? "reported" : "NOT reported");
+    std::printf("fault %s: %u %s notice(s)\n", f.name, findings.withheld_notices(), scene::kWithheldNoticeId);
   }
   return 0;
 }

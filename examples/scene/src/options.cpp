@@ -54,7 +54,8 @@ const char* Usage() {
          "  --static        build the structures in frame 0 only; later frames only trace rays (no animation,\n"
          "                  refit or top-level update)\n"
          "  --out FILE      write the last frame as PNG\n"
-         "  --inject FAULT  after the frames, commit one rule violation (see --list-faults)\n"
+         "  --inject FAULT  after the frames, commit one rule violation (see --list-faults), with asval's protect\n"
+         "                  setting on (VkLayerSettingsCreateInfoEXT)\n"
          "  --checkpoints N,N,...  after each of these frame counts, print the process's resident memory (now and\n"
          "                  peak) and the wall time per frame of the 100 frames before (bench/longrun)\n"
          "  --list-faults   print each fault with the VUID it must trigger\n";

@@ -1,0 +1,738 @@
+// Protect mode (setting `protect`, issue 16) through the real loader on lavapipe, every submission waited for. With
+// protect on and an app messenger that returns VK_FALSE (it never asks for a skip), a command asval reports an error
+// for at record time is not recorded and its command buffer is marked; a submission of a marked command buffer, or one
+// asval reports an error for in execution order, returns VK_ERROR_VALIDATION_FAILED_EXT; a host command with an error
+// returns it without running. Each is named once by an ASVAL-Protect-Withheld information message, and the app goes
+// on: a later valid submission on the same queue runs and signals its fence. Valid programs give the same results
+// with protect on and off; the JSON report holds every finding and notice even when the app aborts right after; the
+// Khronos validation layer below asval never sees a protected command.
+//
+// Record-time cases: one per family with record-time rules (features, handles, structure, alignment, addresses,
+// aliasing, copies). Submit-time cases: the submission of each of those marked command buffers, and the two families
+// with rules judged in execution order (history: an update's flags; copies: serialization room). Host cases: a host
+// build (features) and a host property query (history); lavapipe has no host commands, so only withheld host calls
+// are made (none reaches the driver).
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch_test_macros.hpp>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "history_helpers.h"
+#include "record_checks_helpers.h"
+#include "temp_report.h"
+
+extern char** environ;
+
+namespace asval_test {
+namespace {
+
+constexpr const char* kNotice = "ASVAL-Protect-Withheld";
+constexpr const char* kLayerName = "VK_LAYER_ASVAL_as_validation";
+constexpr VkAccelerationStructureTypeKHR kBottom = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+
+// The run's settings through VkLayerSettingsCreateInfoEXT: `protect` as VK_LAYER_SETTING_TYPE_BOOL32_EXT (the way an
+// app written against VK_EXT_layer_settings turns it on), enabled_checks and report_file as strings when given.
+class RunSettings {
+ public:
+  RunSettings(bool protect, const char* families, std::string report_file)
+      : protect_(protect ? VK_TRUE : VK_FALSE), families_(families), report_(std::move(report_file)) {
+    report_ptr_ = report_.c_str();
+    settings_.push_back({kLayerName, "protect", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &protect_});
+    if (families_) settings_.push_back({kLayerName, "enabled_checks", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &families_});
+    if (!report_.empty()) {
+      settings_.push_back({kLayerName, "report_file", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &report_ptr_});
+    }
+    info_ = {VK_STRUCTURE_TYPE_LAYER_SETTINGS_CREATE_INFO_EXT, nullptr, static_cast<uint32_t>(settings_.size()),
+             settings_.data()};
+  }
+  RunSettings(const RunSettings&) = delete;
+  RunSettings& operator=(const RunSettings&) = delete;
+  const void* Chain() const { return &info_; }
+
+ private:
+  VkBool32 protect_;
+  const char* families_;
+  std::string report_;
+  const char* report_ptr_ = nullptr;
+  std::vector<VkLayerSettingEXT> settings_;
+  VkLayerSettingsCreateInfoEXT info_{};
+};
+
+// A second messenger, for information messages: it keeps asval's ASVAL-Protect-Withheld notices (the Monitor hears
+// errors and warnings only). Returns VK_FALSE.
+class NoticeListener {
+ public:
+  explicit NoticeListener(VkInstance instance) : instance_(instance) {
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    info.pfnUserCallback = &NoticeListener::Callback;
+    info.pUserData = this;
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    vkkit::Check(create(instance, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  }
+  ~NoticeListener() {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(instance_, messenger_, nullptr);
+  }
+  NoticeListener(const NoticeListener&) = delete;
+  NoticeListener& operator=(const NoticeListener&) = delete;
+
+  std::vector<std::string> Take() {
+    std::lock_guard lock(mutex_);
+    return std::move(notices_);
+  }
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL Callback(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                                 VkDebugUtilsMessageTypeFlagsEXT,
+                                                 const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    auto* self = static_cast<NoticeListener*>(user);
+    if (data->pMessageIdName && std::strcmp(data->pMessageIdName, kNotice) == 0) {
+      std::lock_guard lock(self->mutex_);
+      self->notices_.emplace_back(data->pMessage ? data->pMessage : "");
+    }
+    return VK_FALSE;
+  }
+
+  VkInstance instance_;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  std::mutex mutex_;
+  std::vector<std::string> notices_;
+};
+
+// An instance and device under asval with protect on (or off), enabled_checks narrowed to `families` (null: all), the
+// Monitor for errors and warnings (nothing is Expect()ed, so it returns VK_FALSE for every message) and a
+// NoticeListener. `settings_chain` false: nothing chained (protect then comes from the environment).
+class ProtectRun {
+ public:
+  explicit ProtectRun(const char* families = nullptr, bool protect = true, const std::string& report = "",
+                      bool settings_chain = true)
+      : settings_(protect, families, report),
+        fixture_(std::make_unique<Fixture>(settings_chain ? settings_.Chain() : nullptr)),
+        notices_(std::make_unique<NoticeListener>(fixture_->instance().handle())) {}
+  ~ProtectRun() { Close(); }
+  // Destroys the device and the instance now (vkDestroyDevice writes the protect summary).
+  void Close() {
+    notices_.reset();
+    fixture_.reset();
+  }
+  vkkit::Device& device() { return fixture_->device(); }
+  VkInstance instance() { return fixture_->instance().handle(); }
+
+  // Every error and warning since the last call, as "VUID" (errors) or "warning VUID".
+  std::vector<std::string> TakeFindings() {
+    std::vector<std::string> out;
+    for (const Message& m : fixture_->monitor().Take()) {
+      out.push_back(m.severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? m.id_name : "warning " + m.id_name);
+    }
+    return out;
+  }
+  std::vector<std::string> TakeNotices() { return notices_->Take(); }
+
+ private:
+  RunSettings settings_;
+  std::unique_ptr<Fixture> fixture_;
+  std::unique_ptr<NoticeListener> notices_;
+};
+
+using Strings = std::vector<std::string>;
+
+bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+template <typename Fn>
+Fn LoadDevice(vkkit::Device& device, const char* name) {
+  auto fn = reinterpret_cast<Fn>(vkGetDeviceProcAddr(device.handle(), name));
+  if (!fn) throw std::runtime_error(std::string("no ") + name);
+  return fn;
+}
+
+struct Outcome {
+  VkResult result = VK_SUCCESS;
+  bool signaled = false;
+};
+
+// One submission of `cb` with a fence (vkQueueSubmit, or vkQueueSubmit2 when `submit2`), waited for: the result and
+// whether the fence signaled. A withheld submission must leave it unsignaled.
+Outcome SubmitWithFence(vkkit::Device& device, VkCommandBuffer cb, bool submit2 = false) {
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateFence(device.handle(), &fence_info, nullptr, &fence), "vkCreateFence");
+  Outcome out;
+  if (submit2) {
+    VkCommandBufferSubmitInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cb_info.commandBuffer = cb;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.commandBufferInfoCount = 1;
+    submit.pCommandBufferInfos = &cb_info;
+    out.result = LoadDevice<PFN_vkQueueSubmit2>(device, "vkQueueSubmit2")(device.queue(), 1, &submit, fence);
+  } else {
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    out.result = vkQueueSubmit(device.queue(), 1, &submit, fence);
+  }
+  if (out.result == VK_SUCCESS) {
+    out.signaled = vkWaitForFences(device.handle(), 1, &fence, VK_TRUE, 10'000'000'000ull) == VK_SUCCESS;
+  } else {
+    out.signaled = vkGetFenceStatus(device.handle(), fence) == VK_SUCCESS;
+  }
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+  vkDestroyFence(device.handle(), fence, nullptr);
+  return out;
+}
+
+// One bottom-level triangle build over the scene's inputs, with its destination and scratch (Scene::Prepare).
+struct TriangleInfo {
+  explicit TriangleInfo(Scene& scene) : geometry(scene.Triangles()) {
+    info = Scene::Info(kBottom, {geometry});
+    info.pGeometries = &geometry;
+    scene.Prepare(info, {1});
+  }
+  TriangleInfo(const TriangleInfo&) = delete;
+  TriangleInfo& operator=(const TriangleInfo&) = delete;
+  void Record(vkkit::Device& device, VkCommandBuffer cb) const {
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
+  }
+  VkAccelerationStructureGeometryKHR geometry;
+  VkAccelerationStructureBuildGeometryInfoKHR info{};
+  VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+};
+
+// The app goes on after a withheld call: a valid build, submitted on the same queue, runs and signals its fence, and
+// asval says nothing about it.
+void CheckValidSubmissionRuns(ProtectRun& run, Scene& scene) {
+  vkkit::Device& device = run.device();
+  TriangleInfo valid(scene);
+  Commands commands(device);
+  VkCommandBuffer cb = commands.Begin();
+  valid.Record(device, cb);
+  commands.End(cb);
+  const Outcome outcome = SubmitWithFence(device, cb);
+  CHECK(outcome.result == VK_SUCCESS);
+  CHECK(outcome.signaled);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices() == Strings{});
+}
+
+// A record-time violation: the family it belongs to, its exact VUID, the command that breaks it, and how to record it.
+struct RecordCase {
+  const char* family;
+  const char* vuid;
+  const char* function;
+  std::function<void(vkkit::Device&, Scene&, VkCommandBuffer)> record;
+};
+
+std::vector<RecordCase> RecordCases() {
+  return {
+      {"features", "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650",
+       "vkCmdBuildAccelerationStructuresIndirectKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         // Lavapipe has no indirectBuild feature: any indirect build breaks 03650.
+         TriangleInfo t(scene);
+         const VkDeviceAddress ranges = scene.Address(Scene::kSize - 64);
+         const uint32_t stride = 16, max_count = 1;
+         const uint32_t* max_counts = &max_count;
+         const auto indirect = LoadDevice<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
+             device, "vkCmdBuildAccelerationStructuresIndirectKHR");
+         indirect(cb, 1, &t.info, &ranges, &stride, &max_counts);
+       }},
+      {"handles", "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03700", "vkCmdBuildAccelerationStructuresKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         VkAccelerationStructureGeometryKHR triangles = scene.Triangles();
+         VkAccelerationStructureBuildGeometryInfoKHR info = Scene::Info(kBottom, {triangles});
+         info.pGeometries = &triangles;
+         scene.Prepare(info, {1}, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR);  // created as the other level
+         const VkAccelerationStructureBuildRangeInfoKHR range{1, 0, 0, 0};
+         const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+         device.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
+       }},
+      {"structure", "VUID-VkAccelerationStructureBuildGeometryInfoKHR-flags-03796",
+       "vkCmdBuildAccelerationStructuresKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         TriangleInfo t(scene);
+         t.info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+                        VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+         t.Record(device, cb);
+       }},
+      {"alignment", "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710", "vkCmdBuildAccelerationStructuresKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         TriangleInfo t(scene);
+         t.info.scratchData.deviceAddress += device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2;
+         t.Record(device, cb);
+       }},
+      {"addresses", "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-10126", "vkCmdBuildAccelerationStructuresKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         TriangleInfo t(scene);
+         VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+         const uint32_t count = 1;
+         device.GetAccelerationStructureBuildSizesKHR(device.handle(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR,
+                                                      &t.info, &count, &sizes);
+         t.info.dstAccelerationStructure = scene.NewStructure(kBottom, sizes.accelerationStructureSize - 16);
+         t.Record(device, cb);
+       }},
+      {"aliasing", "VUID-vkCmdBuildAccelerationStructuresKHR-scratchData-03704", "vkCmdBuildAccelerationStructuresKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         TriangleInfo a(scene), b(scene);
+         b.info.scratchData = a.info.scratchData;  // two builds of one command share their scratch
+         const VkAccelerationStructureBuildGeometryInfoKHR infos[] = {a.info, b.info};
+         const VkAccelerationStructureBuildRangeInfoKHR* ranges[] = {&a.range, &b.range};
+         device.CmdBuildAccelerationStructuresKHR(cb, 2, infos, ranges);
+       }},
+      {"copies", "VUID-VkCopyAccelerationStructureInfoKHR-mode-03410", "vkCmdCopyAccelerationStructureKHR",
+       [](vkkit::Device& device, Scene& scene, VkCommandBuffer cb) {
+         CmdCopy(device, cb, scene.blas(), scene.NewStructure(kBottom, 1 << 16),
+                 VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR);
+       }},
+  };
+}
+
+// The notice of a withheld submission of a marked command buffer names where it was and the finding behind it.
+void CheckMarkedSubmissionNotice(const Strings& notices, const std::string& where, const RecordCase& c) {
+  REQUIRE(notices.size() == 1);
+  CHECK(Contains(notices[0], where));
+  CHECK(Contains(notices[0], c.function));
+  CHECK(Contains(notices[0], c.vuid));
+  CHECK(Contains(notices[0], "VK_ERROR_VALIDATION_FAILED_EXT"));
+}
+
+TEST_CASE("protect: a record-time error of each family withholds the command and every submission of its command "
+          "buffer; the queue goes on",
+          "[integration][protect]") {
+  for (const RecordCase& c : RecordCases()) {
+    DYNAMIC_SECTION(c.family << ": " << c.vuid) {
+      ProtectRun run(c.family);
+      vkkit::Device& device = run.device();
+      Scene scene(device);
+      Commands commands(device);
+      VkCommandBuffer cb = commands.Begin();
+      c.record(device, scene, cb);
+      commands.End(cb);
+      CHECK(run.TakeFindings() == Strings{c.vuid});
+      const Strings recorded = run.TakeNotices();
+      REQUIRE(recorded.size() == 1);
+      CHECK(Contains(recorded[0], c.function));
+      CHECK(Contains(recorded[0], "not passed down"));
+      CHECK(Contains(recorded[0], c.vuid));
+
+      const Outcome outcome = SubmitWithFence(device, cb);
+      CHECK(outcome.result == VK_ERROR_VALIDATION_FAILED_EXT);
+      CHECK_FALSE(outcome.signaled);
+      CHECK(run.TakeFindings() == Strings{});
+      CheckMarkedSubmissionNotice(run.TakeNotices(), "pSubmits[0].pCommandBuffers[0]", c);
+      // Marked until reset: a second submission is withheld again.
+      CHECK(SubmitWithFence(device, cb).result == VK_ERROR_VALIDATION_FAILED_EXT);
+      CHECK(run.TakeNotices().size() == 1);
+      CheckValidSubmissionRuns(run, scene);
+    }
+  }
+}
+
+TEST_CASE("protect: vkQueueSubmit2 and a primary executing a marked secondary are withheld too",
+          "[integration][protect]") {
+  const RecordCase c = RecordCases()[3];  // alignment
+  ProtectRun run(c.family);
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  Commands commands(device);
+  VkCommandBuffer cb = commands.Begin();
+  c.record(device, scene, cb);
+  commands.End(cb);
+  CHECK(run.TakeFindings() == Strings{c.vuid});
+  CHECK(run.TakeNotices().size() == 1);
+  const Outcome outcome = SubmitWithFence(device, cb, /*submit2=*/true);
+  CHECK(outcome.result == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK_FALSE(outcome.signaled);
+  CheckMarkedSubmissionNotice(run.TakeNotices(), "pSubmits[0].pCommandBufferInfos[0]", c);
+
+  VkCommandBuffer secondary = commands.BeginSecondary();
+  c.record(device, scene, secondary);
+  commands.End(secondary);
+  CHECK(run.TakeFindings() == Strings{c.vuid});
+  CHECK(run.TakeNotices().size() == 1);
+  VkCommandBuffer primary = commands.Begin();
+  Procs(device).CmdExecuteCommands(primary, 1, &secondary);
+  commands.End(primary);
+  const Outcome executed = SubmitWithFence(device, primary);
+  CHECK(executed.result == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK_FALSE(executed.signaled);
+  CheckMarkedSubmissionNotice(run.TakeNotices(), "pSubmits[0].pCommandBuffers[0]", c);
+  // Begun again, the primary holds only what it records now.
+  vkkit::Check(vkResetCommandBuffer(primary, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  vkkit::Check(vkBeginCommandBuffer(primary, &begin), "vkBeginCommandBuffer");
+  TriangleInfo valid(scene);
+  valid.Record(device, primary);
+  commands.End(primary);
+  const Outcome again = SubmitWithFence(device, primary);
+  CHECK(again.result == VK_SUCCESS);
+  CHECK(again.signaled);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices() == Strings{});
+}
+
+// A submission asval finds invalid in execution order: withheld with VK_ERROR_VALIDATION_FAILED_EXT, its fence left
+// unsignaled, one notice; what was recorded reached the command buffer (it was valid when recorded), hence the tag.
+void CheckWithheldSubmission(ProtectRun& run, VkCommandBuffer cb, const char* vuid) {
+  CHECK(run.TakeFindings() == Strings{});  // nothing at record time
+  CHECK(run.TakeNotices() == Strings{});
+  const Outcome outcome = SubmitWithFence(run.device(), cb);
+  CHECK(outcome.result == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK_FALSE(outcome.signaled);
+  CHECK(run.TakeFindings() == Strings{vuid});
+  const Strings notices = run.TakeNotices();
+  REQUIRE(notices.size() == 1);
+  CHECK(Contains(notices[0], "vkQueueSubmit"));
+  CHECK(Contains(notices[0], vuid));
+  CHECK(Contains(notices[0], "in execution order"));
+}
+
+void SubmitValid(ProtectRun& run, VkCommandBuffer cb) {
+  const Outcome outcome = SubmitWithFence(run.device(), cb);
+  CHECK(outcome.result == VK_SUCCESS);
+  CHECK(outcome.signaled);
+}
+
+TEST_CASE("protect: an update that breaks the history in execution order is withheld at submission (history)",
+          "[integration][protect][passes-invalid-down]") {
+  ProtectRun run("history");
+  vkkit::Device& device = run.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  VkCommandBuffer build = commands.Begin();
+  blas.Build(build, Shape{});
+  commands.End(build);
+  SubmitValid(run, build);
+  Shape other_flags;
+  other_flags.flags =
+      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+  VkCommandBuffer update = commands.Begin();
+  blas.Update(update, other_flags);
+  commands.End(update);
+  CheckWithheldSubmission(run, update, "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03759");
+  // The app goes on: an update that repeats the build runs (the withheld one changed no history).
+  VkCommandBuffer valid = commands.Begin();
+  blas.Update(valid, Shape{});
+  commands.End(valid);
+  SubmitValid(run, valid);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices() == Strings{});
+}
+
+TEST_CASE("protect: serializing into less than the serialization size read back is withheld at submission (copies)",
+          "[integration][protect][passes-invalid-down]") {
+  ProtectRun run("copies");
+  vkkit::Device& device = run.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  QueryPool pool(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, 1);
+  Commands commands(device);
+  VkCommandBuffer build = commands.Begin();
+  pool.Reset(build);
+  blas.Build(build, Shape{});
+  commands.Barrier(build);
+  CmdWriteProperties(device, build, {blas.handle()}, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR,
+                     pool.handle(), 0);
+  commands.End(build);
+  SubmitValid(run, build);
+  const uint64_t size = pool.Results()[0];
+  REQUIRE(size > 256);
+  vkkit::Buffer small = device.CreateBuffer(size - 256, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  vkkit::Buffer room = device.CreateBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  VkCommandBuffer serialize = commands.Begin();
+  CmdSerialize(device, serialize, blas.handle(), small.address);
+  commands.End(serialize);
+  CheckWithheldSubmission(run, serialize, "VUID-VkCopyAccelerationStructureToMemoryInfoKHR-dst-03561");
+  VkCommandBuffer valid = commands.Begin();
+  CmdSerialize(device, valid, blas.handle(), room.address);
+  commands.End(valid);
+  SubmitValid(run, valid);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices() == Strings{});
+  device.Destroy(small);
+  device.Destroy(room);
+}
+
+TEST_CASE("protect: host commands with an error return VK_ERROR_VALIDATION_FAILED_EXT without running (features, "
+          "history)",
+          "[integration][protect]") {
+  SECTION("features: a host build without accelerationStructureHostCommands") {
+    ProtectRun run("features");
+    vkkit::Device& device = run.device();
+    Scene scene(device);
+    TriangleInfo t(scene);
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &t.range;
+    const VkResult result = Procs(device).HostBuild(device.handle(), VK_NULL_HANDLE, 1, &t.info, &ranges);
+    CHECK(result == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(run.TakeFindings() ==
+          Strings{"VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581"});
+    const Strings notices = run.TakeNotices();
+    REQUIRE(notices.size() == 1);
+    CHECK(Contains(notices[0], "vkBuildAccelerationStructuresKHR"));
+    CHECK(Contains(notices[0], "accelerationStructureHostCommands-03581"));
+    CheckValidSubmissionRuns(run, scene);
+  }
+  SECTION("history: a host property query of a structure never built") {
+    ProtectRun run("history");
+    vkkit::Device& device = run.device();
+    Scene scene(device);
+    const VkAccelerationStructureKHR never_built = scene.NewStructure(kBottom, 1 << 16);
+    uint64_t value = 0;
+    const VkResult result = Procs(device).HostWriteProperties(
+        device.handle(), 1, &never_built, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, sizeof(value),
+        &value, sizeof(value));
+    CHECK(result == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(run.TakeFindings() ==
+          Strings{"VUID-vkWriteAccelerationStructuresPropertiesKHR-pAccelerationStructures-04964"});
+    const Strings notices = run.TakeNotices();
+    REQUIRE(notices.size() == 1);
+    CHECK(Contains(notices[0], "vkWriteAccelerationStructuresPropertiesKHR"));
+    CheckValidSubmissionRuns(run, scene);
+  }
+}
+
+// What a valid program computes: a bottom-level build, its update, a top-level build over it, the compacted and
+// serialization sizes queried, a compaction and the serialized bytes.
+struct ValidResults {
+  uint64_t compacted_size = 0;
+  uint64_t serialization_size = 0;
+  std::vector<unsigned char> serialized;
+};
+
+ValidResults RunValidProgram(bool protect) {
+  ProtectRun run(nullptr, protect);
+  vkkit::Device& device = run.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs), compacted(device, inputs);
+  Tlas tlas(device);
+  vkkit::Buffer instances = tlas.MakeInstances({&blas});
+  QueryPool compacted_size(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, 1);
+  QueryPool serialization_size(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, 1);
+  Shape shape;
+  shape.flags |= VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+  Commands commands(device);
+  VkCommandBuffer cb = commands.Begin();
+  compacted_size.Reset(cb);
+  serialization_size.Reset(cb);
+  blas.Build(cb, shape);
+  commands.Barrier(cb);
+  blas.Update(cb, shape);
+  commands.Barrier(cb);
+  tlas.Record(cb, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  CmdWriteProperties(device, cb, {blas.handle()}, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
+                     compacted_size.handle(), 0);
+  CmdWriteProperties(device, cb, {blas.handle()}, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR,
+                     serialization_size.handle(), 0);
+  commands.End(cb);
+  Outcome first = SubmitWithFence(device, cb);
+  CHECK(first.result == VK_SUCCESS);
+  CHECK(first.signaled);
+  ValidResults r;
+  r.compacted_size = compacted_size.Results()[0];
+  r.serialization_size = serialization_size.Results()[0];
+  REQUIRE(r.serialization_size > 0);
+  vkkit::Buffer bytes = device.CreateBuffer(r.serialization_size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  VkCommandBuffer copies = commands.Begin();
+  CmdCopy(device, copies, blas.handle(), compacted.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
+  CmdSerialize(device, copies, blas.handle(), bytes.address);
+  commands.End(copies);
+  Outcome second = SubmitWithFence(device, copies);
+  CHECK(second.result == VK_SUCCESS);
+  CHECK(second.signaled);
+  const auto* data = static_cast<const unsigned char*>(bytes.mapped);
+  r.serialized.assign(data, data + r.serialization_size);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices() == Strings{});
+  device.Destroy(bytes);
+  device.Destroy(instances);
+  return r;
+}
+
+TEST_CASE("protect valid twin: build, update, TLAS, compaction query, compaction and serialization give the same "
+          "results with protect on and off, silently",
+          "[integration][protect]") {
+  const ValidResults off = RunValidProgram(false);
+  const ValidResults on = RunValidProgram(true);
+  CHECK(on.compacted_size > 0);
+  CHECK(on.compacted_size == off.compacted_size);
+  CHECK(on.serialization_size == off.serialization_size);
+  CHECK(on.serialized == off.serialized);
+}
+
+// Sets an environment variable for the scope, restoring the value it had (the self-validation run sets some of these).
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      setenv(name_.c_str(), old_->c_str(), 1);
+    } else {
+      unsetenv(name_.c_str());
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
+};
+
+bool KhronosLayerPresent() {
+  uint32_t count = 0;
+  vkEnumerateInstanceLayerProperties(&count, nullptr);
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateInstanceLayerProperties(&count, layers.data());
+  for (const VkLayerProperties& l : layers) {
+    if (std::strcmp(l.layerName, "VK_LAYER_KHRONOS_validation") == 0) return true;
+  }
+  return false;
+}
+
+TEST_CASE("protect: the Khronos validation layer below asval never sees a protected command or submission",
+          "[integration][protect]") {
+  const char* path = std::getenv("VK_LAYER_PATH");
+  const ScopedEnv layer_path("VK_LAYER_PATH", std::string(path ? path : "") + ":/usr/share/vulkan/explicit_layer.d");
+  const ScopedEnv layers("ASVAL_TEST_LAYERS", "VK_LAYER_ASVAL_as_validation:VK_LAYER_KHRONOS_validation");
+  // protect from the environment: the Khronos layer 1.3.239 would report a VkLayerSettingsCreateInfoEXT in pNext.
+  const ScopedEnv protect("VK_ASVAL_AS_VALIDATION_PROTECT", "true");
+  REQUIRE(KhronosLayerPresent());
+  ProtectRun run(nullptr, false, "", /*settings_chain=*/false);
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  Commands commands(device);
+  // Record time: the Khronos layer checks 03710 as well; only asval's report arrives (one message).
+  VkCommandBuffer misaligned = commands.Begin();
+  TriangleInfo t(scene);
+  t.info.scratchData.deviceAddress += device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2;
+  t.Record(device, misaligned);
+  commands.End(misaligned);
+  CHECK(run.TakeFindings() == Strings{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710"});
+  CHECK(run.TakeNotices().size() == 1);
+  CHECK(SubmitWithFence(device, misaligned).result == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(run.TakeFindings() == Strings{});
+  CHECK(run.TakeNotices().size() == 1);
+  // Submission: an update recorded before a rebuild with other flags, submitted after it. Valid when recorded (the
+  // Khronos layer, which judges updates by the build recorded last, agrees), invalid in execution order.
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  VkCommandBuffer build = commands.Begin();
+  blas.Build(build, Shape{});
+  commands.End(build);
+  SubmitValid(run, build);
+  VkCommandBuffer update = commands.Begin();
+  blas.Update(update, Shape{});
+  commands.End(update);
+  Shape other_flags;
+  other_flags.flags =
+      VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR;
+  VkCommandBuffer rebuild = commands.Begin();
+  blas.Build(rebuild, other_flags);
+  commands.End(rebuild);
+  SubmitValid(run, rebuild);
+  CheckWithheldSubmission(run, update, "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03759");
+  CheckValidSubmissionRuns(run, scene);
+}
+
+TEST_CASE("protect off control: the Khronos validation layer below asval reports the command asval lets through",
+          "[integration][protect][passes-invalid-down]") {
+  const char* path = std::getenv("VK_LAYER_PATH");
+  const ScopedEnv layer_path("VK_LAYER_PATH", std::string(path ? path : "") + ":/usr/share/vulkan/explicit_layer.d");
+  const ScopedEnv layers("ASVAL_TEST_LAYERS", "VK_LAYER_ASVAL_as_validation:VK_LAYER_KHRONOS_validation");
+  const ScopedEnv protect("VK_ASVAL_AS_VALIDATION_PROTECT", "false");
+  REQUIRE(KhronosLayerPresent());
+  ProtectRun run(nullptr, false, "", /*settings_chain=*/false);
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  Commands commands(device);
+  // Recorded, never submitted: the misaligned build reaches the Khronos layer, which reports it too.
+  VkCommandBuffer misaligned = commands.Begin();
+  TriangleInfo t(scene);
+  t.info.scratchData.deviceAddress += device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2;
+  t.Record(device, misaligned);
+  commands.End(misaligned);
+  CHECK(run.TakeFindings() == Strings{"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710",
+                                      "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710"});
+  CHECK(run.TakeNotices() == Strings{});
+}
+
+// The JSON report's lines as "severity vuid function".
+Strings ReportSummary(const asval_test_common::TempReport& report) {
+  Strings out;
+  for (const std::string& line : report.Lines()) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    out.push_back(j.value("severity", "") + " " + j.value("vuid", "") + " " + j.value("function", ""));
+  }
+  return out;
+}
+
+constexpr const char* kChildReportEnv = "ASVAL_PROTECT_CHILD_REPORT";
+
+// Run only by the test below, in a child process: protected calls, then an abort with everything still alive.
+TEST_CASE("protect child: withheld calls, then abort()", "[.][protect-report-child]") {
+  const char* path = std::getenv(kChildReportEnv);
+  REQUIRE(path);
+  ProtectRun run(nullptr, true, path);
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  Commands commands(device);
+  VkCommandBuffer cb = commands.Begin();
+  RecordCases()[3].record(device, scene, cb);  // alignment: 03710
+  commands.End(cb);
+  REQUIRE(SubmitWithFence(device, cb).result == VK_ERROR_VALIDATION_FAILED_EXT);
+  TriangleInfo host(scene);
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &host.range;
+  REQUIRE(Procs(device).HostBuild(device.handle(), VK_NULL_HANDLE, 1, &host.info, &ranges) ==
+          VK_ERROR_VALIDATION_FAILED_EXT);
+  signal(SIGABRT, SIG_DFL);  // no handler of the test framework's: the app dies here
+  std::abort();
+}
+
+TEST_CASE("protect: the JSON report holds every finding and every notice, one line each, when the app aborts right "
+          "after",
+          "[integration][protect]") {
+  asval_test_common::TempReport report;
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e) env.emplace_back(*e);
+  env.push_back(std::string(kChildReportEnv) + "=" + report.path);
+  std::vector<char*> envp;
+  for (std::string& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  char self[] = "/proc/self/exe";
+  char filter[] = "[protect-report-child]";
+  char* argv[] = {self, filter, nullptr};
+  pid_t pid = 0;
+  REQUIRE(posix_spawn(&pid, self, nullptr, nullptr, argv, envp.data()) == 0);
+  int status = 0;
+  REQUIRE(waitpid(pid, &status, 0) == pid);
+  REQUIRE(WIFSIGNALED(status));
+  CHECK(WTERMSIG(status) == SIGABRT);
+  CHECK(ReportSummary(report) ==
+        Strings{"error VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710 vkCmdBuildAccelerationStructuresKHR",
+                "info ASVAL-Protect-Withheld vkCmdBuildAccelerationStructuresKHR",
+                "info ASVAL-Protect-Withheld vkQueueSubmit",
+                "error VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581 "
+                "vkBuildAccelerationStructuresKHR",
+                "info ASVAL-Protect-Withheld vkBuildAccelerationStructuresKHR"});
+}
+
+}  // namespace
+}  // namespace asval_test
