@@ -15,6 +15,7 @@
 
 #include "capture_helpers.h"
 #include "history_helpers.h"
+#include "temp_report.h"
 
 namespace asval_test {
 namespace {
@@ -648,6 +649,73 @@ TEST_CASE("capture: a triangle geometry whose transform holds an infinity gets t
     rig.Build(cb, shape);
   }));
   CHECK(OnlyFinding(f.monitor(), "ASVAL-Capture-NonFiniteTransform", "geometry 0: its transform") == "");
+}
+
+// Protect mode (issue 16, docs/protect.md) and a rule judged at completion: the update that broke it already ran,
+// so every later submission on the device is withheld, each named in an ASVAL-Protect-Withheld line of the report.
+std::vector<std::string> ProtectLines(const asval_test_common::TempReport& report) {
+  std::vector<std::string> out;
+  for (const std::string& line : report.Lines()) {
+    if (line.find("\"vuid\":\"ASVAL-Protect-Withheld\"") != std::string::npos ||
+        line.find("Protect mode kept from the driver") != std::string::npos) {
+      out.push_back(line);
+    }
+  }
+  return out;
+}
+
+TEST_CASE("capture: with protect on, an error judged at completion withholds every later submission",
+          "[integration][capture][protect]") {
+  asval_test_common::TempReport report;
+  HistoryFixture f(nullptr, {{"protect", "true"}, {"report_file", report.path.c_str()}});
+  {
+    Rig rig(f);
+    BuildTriangles(rig);
+    rig.Run(rig.Record([&](VkCommandBuffer cb) {
+      rig.Fill(cb, Component(0, 0), kNan);
+      rig.Update(cb, Triangles());
+    }));
+    CHECK(OnlyFinding(f.monitor(), kBecameInactive, ": primitive 0") == "");
+    // A valid rebuild, on a queue whose device ran a rule-breaking update: withheld.
+    const VkCommandBuffer rebuild = rig.Record([&](VkCommandBuffer cb) { rig.Build(cb, Triangles()); });
+    CHECK(rig.commands().Submit(rebuild) == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(rig.commands().Submit(rebuild) == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(f.monitor().Verify() == "");
+  }
+  f.Close();
+  const std::vector<std::string> lines = ProtectLines(report);
+  REQUIRE(lines.size() == 4);
+  CHECK(lines[0].find("\"function\":\"vkCmdBuildAccelerationStructuresKHR\"") != std::string::npos);
+  CHECK(lines[0].find(std::string("asval reported ") + kBecameInactive) != std::string::npos);
+  CHECK(lines[0].find("Every later submission on this device is withheld") != std::string::npos);
+  for (int i : {1, 2}) {
+    CHECK(lines[i].find("\"function\":\"vkQueueSubmit\"") != std::string::npos);
+    CHECK(lines[i].find(std::string("found when it completed: ") + kBecameInactive) != std::string::npos);
+  }
+  CHECK(lines[3].find("recorded_commands_withheld=0 submissions_withheld=2 host_commands_withheld=0 "
+                      "submissions_halted_by_completion_error=1") != std::string::npos);
+}
+
+TEST_CASE("capture: with protect on, updates judged valid at completion leave later submissions alone",
+          "[integration][capture][protect]") {
+  asval_test_common::TempReport report;
+  HistoryFixture f(nullptr, {{"protect", "true"}, {"report_file", report.path.c_str()}});
+  {
+    Rig rig(f);
+    BuildTriangles(rig);
+    // The same update with the vertices moved (activity unchanged): judged, and valid.
+    rig.Run(rig.Record([&](VkCommandBuffer cb) {
+      rig.Write(cb, Component(0, 0), Vertices(0.5f));
+      rig.Update(cb, Triangles());
+    }));
+    const VkCommandBuffer rebuild = rig.Record([&](VkCommandBuffer cb) { rig.Build(cb, Triangles()); });
+    CHECK(rig.commands().Submit(rebuild) == VK_SUCCESS);
+    CHECK(f.monitor().Verify() == "");
+    // The updates were judged: the probe's activity change is still found (and halts what follows).
+    CHECK(Probe(rig, f.monitor(), Triangles()) == "");
+  }
+  f.Close();
+  CHECK(ProtectLines(report).size() == 2);  // the probe's halt and the summary; nothing before it
 }
 
 }  // namespace
