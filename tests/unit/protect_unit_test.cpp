@@ -39,10 +39,13 @@ struct Calls {
   int cmd_build = 0;
   int cmd_build_indirect = 0;
   int cmd_copy = 0;
+  int cmd_copy_to_memory = 0;
+  int cmd_copy_from_memory = 0;
   int cmd_write_properties = 0;
   int execute_commands = 0;
   int host_build = 0;
   int host_copy = 0;
+  int host_write_properties = 0;
   int queue_submit = 0;
   int queue_submit2 = 0;
 } g_calls;
@@ -57,6 +60,12 @@ VKAPI_ATTR void VKAPI_CALL FakeCmdBuildIndirect(VkCommandBuffer, uint32_t,
   ++g_calls.cmd_build_indirect;
 }
 VKAPI_ATTR void VKAPI_CALL FakeCmdCopy(VkCommandBuffer, const VkCopyAccelerationStructureInfoKHR*) { ++g_calls.cmd_copy; }
+VKAPI_ATTR void VKAPI_CALL FakeCmdCopyToMemory(VkCommandBuffer, const VkCopyAccelerationStructureToMemoryInfoKHR*) {
+  ++g_calls.cmd_copy_to_memory;
+}
+VKAPI_ATTR void VKAPI_CALL FakeCmdCopyFromMemory(VkCommandBuffer, const VkCopyMemoryToAccelerationStructureInfoKHR*) {
+  ++g_calls.cmd_copy_from_memory;
+}
 VKAPI_ATTR void VKAPI_CALL FakeCmdWriteProperties(VkCommandBuffer, uint32_t, const VkAccelerationStructureKHR*,
                                                   VkQueryType, VkQueryPool, uint32_t) {
   ++g_calls.cmd_write_properties;
@@ -72,6 +81,11 @@ VKAPI_ATTR VkResult VKAPI_CALL FakeHostBuild(VkDevice, VkDeferredOperationKHR, u
 }
 VKAPI_ATTR VkResult VKAPI_CALL FakeHostCopy(VkDevice, VkDeferredOperationKHR, const VkCopyAccelerationStructureInfoKHR*) {
   ++g_calls.host_copy;
+  return VK_SUCCESS;
+}
+VKAPI_ATTR VkResult VKAPI_CALL FakeHostWriteProperties(VkDevice, uint32_t, const VkAccelerationStructureKHR*, VkQueryType,
+                                                       size_t, void*, size_t) {
+  ++g_calls.host_write_properties;
   return VK_SUCCESS;
 }
 VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t, const VkSubmitInfo*, VkFence) {
@@ -176,9 +190,12 @@ class FakeDevice {
     d.CmdBuildAccelerationStructuresIndirectKHR = &FakeCmdBuildIndirect;
     d.CmdCopyAccelerationStructureKHR = &FakeCmdCopy;
     d.CmdWriteAccelerationStructuresPropertiesKHR = &FakeCmdWriteProperties;
+    d.CmdCopyAccelerationStructureToMemoryKHR = &FakeCmdCopyToMemory;
+    d.CmdCopyMemoryToAccelerationStructureKHR = &FakeCmdCopyFromMemory;
     d.CmdExecuteCommands = &FakeExecuteCommands;
     d.BuildAccelerationStructuresKHR = &FakeHostBuild;
     d.CopyAccelerationStructureKHR = &FakeHostCopy;
+    d.WriteAccelerationStructuresPropertiesKHR = &FakeHostWriteProperties;
     d.QueueSubmit = &FakeQueueSubmit;
     d.QueueSubmit2 = &FakeQueueSubmit2;
     d.BeginCommandBuffer = &FakeBegin;
@@ -222,6 +239,17 @@ class FakeDevice {
     submit.pCommandBufferInfos = &info;
     return hooks::QueueSubmit2(queue(), 1, &submit, VK_NULL_HANDLE);
   }
+  // The geometry count of as's last executed build, as the history keeps it; -1 when the history holds no build.
+  int GeometriesOfLastBuild(VkAccelerationStructureKHR as) const {
+    auto lock = state_->history.store.Lock();
+    const AsHistory h = state_->history.store.Get(as);
+    return h.kind == HistoryKind::kBuilt && h.build ? static_cast<int>(h.build->geometries.size()) : -1;
+  }
+  // Bumped by every executed change of as's contents.
+  uint64_t Generation(VkAccelerationStructureKHR as) const {
+    auto lock = state_->history.store.Lock();
+    return state_->history.store.Get(as).generation;
+  }
   std::shared_ptr<const WithheldCommand> Withheld(int i) const { return state_->command_buffers.Withheld(cb(i)); }
   const ProtectCounters& counters() const { return state_->protect_counters; }
   VkQueryPool QueryPool(VkQueryType type, uint32_t count) {
@@ -256,6 +284,7 @@ class FakeDevice {
   VkAccelerationStructureKHR a = VK_NULL_HANDLE, b = VK_NULL_HANDLE, c = VK_NULL_HANDLE;
   VkAccelerationStructureKHR ha = VK_NULL_HANDLE, hb = VK_NULL_HANDLE;
   VkBuffer vertices = VK_NULL_HANDLE, scratch = VK_NULL_HANDLE, indirect = VK_NULL_HANDLE, arena = VK_NULL_HANDLE;
+  VkBuffer serialized = VK_NULL_HANDLE;  // room for serialized structures
 
  private:
   void SetUpState(DeviceState& state) {
@@ -286,6 +315,8 @@ class FakeDevice {
     vertices = Buffer(4096, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR, 1);
     scratch = Buffer(1 << 20, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
     indirect = Buffer(4096, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, 1);
+    serialized = Buffer(1 << 16, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1);
 
     state.command_buffers.CreatePool(Fake<VkCommandPool>(3), 0);
     const VkCommandBuffer primaries[] = {cb(0), cb(1), cb(3)};
@@ -399,6 +430,14 @@ struct TriangleBuild {
   }
 };
 
+// Records into command buffer i a build of a whose destination is no structure (dstAccelerationStructure-03800).
+void RecordInvalidBuild(FakeDevice& d, int i) {
+  TriangleBuild build(d, d.a, 1, false);
+  build.info.dstAccelerationStructure = Fake<VkAccelerationStructureKHR>(0xdead);
+  build.Record(FakeDevice::cb(i));
+}
+const char kInvalidBuildVuid[] = "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03800";
+
 // ---- record-time cases ------------------------------------------------------------------------------------------
 
 // One recorded command, invalid or made valid, and what must (not) reach the driver.
@@ -460,6 +499,29 @@ std::vector<RecordCase> RecordCases() {
                      copy.mode = valid ? VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR
                                        : VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
                      hooks::CmdCopyAccelerationStructureKHR(FakeDevice::cb(0), &copy);
+                   }});
+  cases.push_back({"copies (to memory)", "VUID-VkCopyAccelerationStructureToMemoryInfoKHR-mode-03412",
+                   "vkCmdCopyAccelerationStructureToMemoryKHR", &Calls::cmd_copy_to_memory,
+                   [](FakeDevice& d, bool valid) {
+                     TriangleBuild(d, d.a, 1, false).Record(FakeDevice::cb(0));
+                     VkCopyAccelerationStructureToMemoryInfoKHR copy{
+                         VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+                     copy.src = d.a;
+                     copy.dst.deviceAddress = d.AddressOf(d.serialized);
+                     copy.mode = valid ? VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR
+                                       : VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+                     hooks::CmdCopyAccelerationStructureToMemoryKHR(FakeDevice::cb(0), &copy);
+                   }});
+  cases.push_back({"copies (from memory)", "VUID-VkCopyMemoryToAccelerationStructureInfoKHR-mode-03413",
+                   "vkCmdCopyMemoryToAccelerationStructureKHR", &Calls::cmd_copy_from_memory,
+                   [](FakeDevice& d, bool valid) {
+                     VkCopyMemoryToAccelerationStructureInfoKHR copy{
+                         VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+                     copy.src.deviceAddress = d.AddressOf(d.serialized);
+                     copy.dst = d.b;
+                     copy.mode = valid ? VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR
+                                       : VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+                     hooks::CmdCopyMemoryToAccelerationStructureKHR(FakeDevice::cb(0), &copy);
                    }});
   cases.push_back({"copies (properties)", "VUID-vkCmdWriteAccelerationStructuresPropertiesKHR-query-04880",
                    "vkCmdWriteAccelerationStructuresPropertiesKHR", &Calls::cmd_write_properties,
@@ -555,6 +617,16 @@ std::vector<HostCase> HostCases() {
                                        : VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
                      return hooks::CopyAccelerationStructureKHR(FakeDevice::device(), VK_NULL_HANDLE, &copy);
                    }});
+  cases.push_back({"copies (host properties)", "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-06742",
+                   "vkWriteAccelerationStructuresPropertiesKHR", &Calls::host_write_properties, 0,
+                   [](FakeDevice& d, bool valid) {
+                     REQUIRE(TriangleBuild(d, d.ha, 1, false, true).RunOnHost() == VK_SUCCESS);
+                     VkDeviceSize size = 0;
+                     return hooks::WriteAccelerationStructuresPropertiesKHR(
+                         FakeDevice::device(), 1, &d.ha,
+                         valid ? VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR : VK_QUERY_TYPE_OCCLUSION, sizeof(size),
+                         &size, sizeof(size));
+                   }});
   return cases;
 }
 
@@ -580,6 +652,19 @@ TEST_CASE("protect: a host command with an error returns VK_ERROR_VALIDATION_FAI
       CHECK(d.counters().host_commands_withheld.load() == 0);
     }
   }
+}
+
+TEST_CASE("protect: a withheld host update leaves the structure's history as it was", "[protect]") {
+  FakeDevice d(Protect());
+  REQUIRE(TriangleBuild(d, d.ha, 1, false, true).RunOnHost() == VK_SUCCESS);
+  const uint64_t generation = d.Generation(d.ha);
+  REQUIRE(generation != 0);
+  CHECK(TriangleBuild(d, d.ha, 2, true, true).RunOnHost() == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Generation(d.ha) == generation);
+  CHECK(d.GeometriesOfLastBuild(d.ha) == 1);
+  CHECK(TriangleBuild(d, d.ha, 1, true, true).RunOnHost() == VK_SUCCESS);
+  CHECK(g_calls.host_build == 2);
+  CHECK(d.Errors() == std::vector<std::string>{"VUID-vkBuildAccelerationStructuresKHR-pInfos-03758"});
 }
 
 // ---- submit-time cases ------------------------------------------------------------------------------------------
@@ -610,7 +695,9 @@ TEST_CASE("protect: a submission with an error in execution order is withheld an
   const std::string vuid = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758";
   FakeDevice d(Protect());
   RecordRebuildThenUpdate(d);
+  const uint64_t generation = d.Generation(d.a);
   CHECK(d.Submit(1) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Generation(d.a) == generation);
   CHECK(g_calls.queue_submit == 1);  // the first submission only
   CHECK(d.Errors() == std::vector<std::string>{vuid});
   const std::vector<Message> notices = d.Notices();
@@ -620,8 +707,17 @@ TEST_CASE("protect: a submission with an error in execution order is withheld an
   CHECK(d.counters().submissions_withheld.load() == 1);
   CHECK(d.counters().commands_withheld.load() == 0);
   CHECK_FALSE(d.Withheld(1));  // a submit-time finding marks nothing
+  CHECK(d.GeometriesOfLastBuild(d.a) == 1);
 
-  // Judged as if the rebuild had never executed: an update with one geometry is valid.
+  // Judged as if the rebuild had never executed: an update with two geometries contradicts the first build...
+  d.Forget();
+  d.Begin(3);
+  TriangleBuild(d, d.a, 2, true).Record(FakeDevice::cb(3));
+  d.End(3);
+  CHECK(d.Submit(3) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Errors() == std::vector<std::string>{vuid});
+  CHECK(g_calls.queue_submit == 1);
+  // ...and one with one geometry is valid.
   d.Forget();
   RecordUpdateOfOneGeometry(d);
   CHECK(d.Submit(3) == VK_SUCCESS);
@@ -634,7 +730,9 @@ TEST_CASE("protect: vkQueueSubmit2 withholds a submission with an error in execu
   const std::string vuid = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758";
   FakeDevice d(Protect());
   RecordRebuildThenUpdate(d);
+  const uint64_t generation = d.Generation(d.a);
   CHECK(d.Submit2(1) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Generation(d.a) == generation);
   CHECK(g_calls.queue_submit2 == 0);
   CHECK(d.Errors() == std::vector<std::string>{vuid});
   const std::vector<Message> notices = d.Notices();
@@ -645,6 +743,67 @@ TEST_CASE("protect: vkQueueSubmit2 withholds a submission with an error in execu
   RecordUpdateOfOneGeometry(d);
   CHECK(d.Submit2(3) == VK_SUCCESS);
   CHECK(g_calls.queue_submit2 == 1);
+  CHECK(d.Errors().empty());
+}
+
+TEST_CASE("protect: past the duplicate limit a submit-time error still withholds its submission", "[protect]") {
+  const std::string vuid = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758";
+  ReportSettings settings = Protect();
+  settings.duplicate_message_limit = 1;
+  FakeDevice d(settings);
+  RecordRebuildThenUpdate(d);
+  CHECK(d.Submit(1) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Submit(1) == VK_ERROR_VALIDATION_FAILED_EXT);  // the same error again: not reported, still withheld
+  CHECK(g_calls.queue_submit == 1);
+  CHECK(d.Errors() == std::vector<std::string>{vuid});
+  CHECK(d.Notices().size() == 2);
+  CHECK(d.counters().submissions_withheld.load() == 2);
+}
+
+TEST_CASE("protect off: a submit-time error is reported and the submission goes down, its history kept",
+          "[protect]") {
+  const std::string vuid = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03758";
+  FakeDevice d(ReportSettings{});
+  RecordRebuildThenUpdate(d);
+  const uint64_t generation = d.Generation(d.a);
+  CHECK(d.Submit(1) == VK_SUCCESS);
+  CHECK(g_calls.queue_submit == 2);
+  CHECK(d.Errors() == std::vector<std::string>{vuid});
+  CHECK(d.Notices().empty());
+  CHECK(d.Generation(d.a) > generation);  // what executed is in the history (protect mode undoes it)
+}
+
+TEST_CASE("protect: a submission with a marked command buffer after a clean one applies nothing of either",
+          "[protect]") {
+  FakeDevice d(Protect());
+  d.Begin(0);
+  TriangleBuild(d, d.a, 1, false).Record(FakeDevice::cb(0));
+  d.End(0);
+  REQUIRE(d.Submit(0) == VK_SUCCESS);
+  d.Begin(1);
+  TriangleBuild(d, d.a, 2, false).Record(FakeDevice::cb(1));  // valid: a rebuild with two geometries
+  d.End(1);
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  d.Forget();
+  const VkCommandBuffer both[] = {FakeDevice::cb(1), FakeDevice::cb(0)};
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 2;
+  submit.pCommandBuffers = both;
+  const uint64_t generation = d.Generation(d.a);
+  CHECK(hooks::QueueSubmit(FakeDevice::queue(), 1, &submit, VK_NULL_HANDLE) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Generation(d.a) == generation);
+  CHECK(d.GeometriesOfLastBuild(d.a) == 1);
+  CHECK(g_calls.queue_submit == 1);
+  const std::vector<Message> notices = d.Notices();
+  REQUIRE(notices.size() == 1);
+  CHECK(notices[0].text.find("pSubmits[0].pCommandBuffers[1]") != std::string::npos);
+  // The rebuild in command buffer 1 never executed: an update with one geometry is valid.
+  d.Forget();
+  RecordUpdateOfOneGeometry(d);
+  CHECK(d.Submit(3) == VK_SUCCESS);
+  CHECK(g_calls.queue_submit == 2);
   CHECK(d.Errors().empty());
 }
 
@@ -702,14 +861,6 @@ TEST_CASE("protect: a property query of a structure built without compaction is 
 }
 
 // ---- marks: secondaries, reset --------------------------------------------------------------------------------
-
-// Records into command buffer i a build of a whose destination is no structure (dstAccelerationStructure-03800).
-void RecordInvalidBuild(FakeDevice& d, int i) {
-  TriangleBuild build(d, d.a, 1, false);
-  build.info.dstAccelerationStructure = Fake<VkAccelerationStructureKHR>(0xdead);
-  build.Record(FakeDevice::cb(i));
-}
-const char kInvalidBuildVuid[] = "VUID-vkCmdBuildAccelerationStructuresKHR-dstAccelerationStructure-03800";
 
 TEST_CASE("protect: a withheld command in a secondary withholds the primary that executes it", "[protect]") {
   FakeDevice d(Protect());
@@ -828,6 +979,51 @@ TEST_CASE("protect: past the duplicate limit an error is still withheld, and eac
 TEST_CASE("protect: an error muted by message_id_filter is not withheld", "[protect]") {
   ReportSettings settings = Protect();
   settings.message_id_filter = {kInvalidBuildVuid};
+  FakeDevice d(settings);
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  CHECK(g_calls.cmd_build == 1);
+  CHECK(d.Errors().empty());
+  CHECK(d.Notices().empty());
+  CHECK_FALSE(d.Withheld(0));
+  CHECK(d.Submit(0) == VK_SUCCESS);
+  CHECK(g_calls.queue_submit == 1);
+}
+
+TEST_CASE("protect: a callback returning VK_TRUE with protect on: withheld, marked and announced", "[protect]") {
+  FakeDevice d(Protect(), VK_TRUE);
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  CHECK(g_calls.cmd_build == 0);
+  CHECK(d.Errors() == std::vector<std::string>{kInvalidBuildVuid});
+  CHECK(d.Withheld(0));
+  CHECK(d.Notices().size() == 1);
+  CHECK(d.Submit(0) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(g_calls.queue_submit == 0);
+}
+
+TEST_CASE("protect: muting ASVAL-Protect-Withheld hides the notice, not the protection", "[protect]") {
+  ReportSettings settings = Protect();
+  settings.message_id_filter = {kNotice};
+  FakeDevice d(settings);
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  CHECK(g_calls.cmd_build == 0);
+  CHECK(d.Errors() == std::vector<std::string>{kInvalidBuildVuid});
+  CHECK(d.Notices().empty());
+  CHECK(d.Withheld(0));
+  CHECK(d.Submit(0) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(g_calls.queue_submit == 0);
+  CHECK(d.counters().commands_withheld.load() == 1);
+  CHECK(d.counters().submissions_withheld.load() == 1);
+}
+
+TEST_CASE("protect: with errors filtered out of report_flags nothing is withheld", "[protect]") {
+  ReportSettings settings = Protect();
+  settings.report_errors = false;
   FakeDevice d(settings);
   d.Begin(0);
   RecordInvalidBuild(d, 0);
