@@ -32,7 +32,7 @@ struct FakeDispatchable {
 };
 int g_table;  // its address is the dispatch key shared by the fake device, queue and command buffers
 FakeDispatchable g_device_object{&g_table}, g_queue_object{&g_table};
-FakeDispatchable g_cb_objects[4] = {{&g_table}, {&g_table}, {&g_table}, {&g_table}};
+FakeDispatchable g_cb_objects[5] = {{&g_table}, {&g_table}, {&g_table}, {&g_table}, {&g_table}};  // 4: never allocated
 
 // What arrived at the driver.
 struct Calls {
@@ -99,6 +99,7 @@ VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit2(VkQueue, uint32_t, const VkSubmi
 VKAPI_ATTR VkResult VKAPI_CALL FakeBegin(VkCommandBuffer, const VkCommandBufferBeginInfo*) { return VK_SUCCESS; }
 VKAPI_ATTR VkResult VKAPI_CALL FakeEnd(VkCommandBuffer) { return VK_SUCCESS; }
 VKAPI_ATTR VkResult VKAPI_CALL FakeReset(VkCommandBuffer, VkCommandBufferResetFlags) { return VK_SUCCESS; }
+VKAPI_ATTR VkResult VKAPI_CALL FakeResetPool(VkDevice, VkCommandPool, VkCommandPoolResetFlags) { return VK_SUCCESS; }
 VKAPI_ATTR void VKAPI_CALL FakeDestroyDevice(VkDevice, const VkAllocationCallbacks*) {}
 
 constexpr VkDeviceAddress kAddressSpacing = 0x1000000;  // buffers up to 16 MiB never share addresses
@@ -141,12 +142,19 @@ struct Message {
 struct Collected {
   std::vector<Message> messages;
   VkBool32 answer = VK_FALSE;  // what the app's callback returns
+  // Run once from inside the callback, at the first error (an app that calls Vulkan from its callback).
+  std::function<void()> on_first_error;
 };
 VKAPI_ATTR VkBool32 VKAPI_CALL Collect(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                        VkDebugUtilsMessageTypeFlagsEXT,
                                        const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   auto* c = static_cast<Collected*>(user);
   c->messages.push_back(Message{severity, data->pMessageIdName, data->pMessage});
+  if (severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT && c->on_first_error) {
+    const std::function<void()> action = std::move(c->on_first_error);
+    c->on_first_error = nullptr;
+    action();
+  }
   return c->answer;
 }
 
@@ -201,6 +209,7 @@ class FakeDevice {
     d.BeginCommandBuffer = &FakeBegin;
     d.EndCommandBuffer = &FakeEnd;
     d.ResetCommandBuffer = &FakeReset;
+    d.ResetCommandPool = &FakeResetPool;
     d.DestroyDevice = &FakeDestroyDevice;
     d.GetBufferDeviceAddress = &FakeBufferAddress;
     d.GetAccelerationStructureDeviceAddressKHR = &FakeStructureAddress;
@@ -921,6 +930,62 @@ TEST_CASE("protect: vkBeginCommandBuffer (an implicit reset) clears the mark", "
   ExpectMarkClearedBy([](FakeDevice& d) { d.Begin(0); });
 }
 
+TEST_CASE("protect: vkResetCommandPool clears the marks of its command buffers", "[protect]") {
+  ExpectMarkClearedBy([](FakeDevice& d) {
+    REQUIRE(hooks::ResetCommandPool(FakeDevice::device(), Fake<VkCommandPool>(3), 0) == VK_SUCCESS);
+    CHECK_FALSE(d.Withheld(0));
+    d.Begin(0);
+  });
+}
+
+TEST_CASE("protect: a command withheld from a command buffer the layer never saw allocated is named as such",
+          "[protect]") {
+  FakeDevice d(Protect());
+  REQUIRE(hooks::BeginCommandBuffer(FakeDevice::cb(4), nullptr) == VK_SUCCESS);
+  RecordInvalidBuild(d, 4);
+  CHECK(g_calls.cmd_build == 0);
+  CHECK(d.Errors() == std::vector<std::string>{kInvalidBuildVuid});
+  const std::vector<Message> notices = d.Notices();
+  REQUIRE(notices.size() == 1);
+  CHECK(notices[0].text.find("never saw this command buffer allocated") != std::string::npos);
+  CHECK(d.counters().commands_withheld.load() == 1);
+  CHECK_FALSE(d.Withheld(4));
+}
+
+TEST_CASE("protect: a callback that records a valid command from inside a report: only the invalid one is withheld",
+          "[protect]") {
+  FakeDevice d(Protect());
+  d.Begin(1);
+  d.collected.on_first_error = [&d] { TriangleBuild(d, d.a, 1, false).Record(FakeDevice::cb(1)); };
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  d.End(1);
+  CHECK(g_calls.cmd_build == 1);  // the valid one, recorded from the callback
+  CHECK(d.Withheld(0));
+  CHECK_FALSE(d.Withheld(1));
+  CHECK(d.Notices().size() == 1);
+  CHECK(d.Submit(1) == VK_SUCCESS);
+  CHECK(d.Submit(0) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(g_calls.queue_submit == 1);
+}
+
+TEST_CASE("protect: a callback that records an invalid command from inside a report: both are withheld",
+          "[protect]") {
+  FakeDevice d(Protect());
+  d.Begin(1);
+  d.collected.on_first_error = [&d] { RecordInvalidBuild(d, 1); };
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  d.End(1);
+  CHECK(g_calls.cmd_build == 0);
+  CHECK(d.Withheld(0));
+  CHECK(d.Withheld(1));
+  CHECK(d.Notices().size() == 2);
+  CHECK(d.counters().commands_withheld.load() == 2);
+}
+
 // ---- protect off, the app's callback, the reporter's filters ----------------------------------------------------
 
 TEST_CASE("protect off (the default): the error is reported and the command reaches the driver", "[protect]") {
@@ -1101,6 +1166,12 @@ TEST_CASE("protect: the JSON report has one ASVAL-Protect-Withheld line per with
   {
     FakeDevice d(settings);
     WithholdTwoCommandsOneSubmissionOneHostBuild(d);
+    // Flushed as written: an app that dies now (a hang, a crash) leaves every line in the file.
+    int notices_so_far = 0;
+    for (const std::string& line : report.Lines()) {
+      if (nlohmann::json::parse(line).value("vuid", "") == kNotice) ++notices_so_far;
+    }
+    CHECK(notices_so_far == 4);
     hooks::DestroyDevice(FakeDevice::device(), nullptr);
   }  // the reporter (and its file) closes with the instance
   int notices = 0, errors = 0, summaries = 0;
