@@ -46,9 +46,14 @@ constexpr VkAccelerationStructureTypeKHR kBottom = VK_ACCELERATION_STRUCTURE_TYP
 // app written against VK_EXT_layer_settings turns it on), enabled_checks and report_file as strings when given.
 class RunSettings {
  public:
-  RunSettings(bool protect, const char* families, std::string report_file)
-      : protect_(protect ? VK_TRUE : VK_FALSE), families_(families), report_(std::move(report_file)) {
+  RunSettings(bool protect, const char* families, std::string report_file, const char* duplicate_limit = nullptr)
+      : protect_(protect ? VK_TRUE : VK_FALSE), families_(families), report_(std::move(report_file)),
+        duplicate_limit_(duplicate_limit) {
     report_ptr_ = report_.c_str();
+    if (duplicate_limit_) {
+      settings_.push_back(
+          {kLayerName, "duplicate_message_limit", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &duplicate_limit_});
+    }
     settings_.push_back({kLayerName, "protect", VK_LAYER_SETTING_TYPE_BOOL32_EXT, 1, &protect_});
     if (families_) settings_.push_back({kLayerName, "enabled_checks", VK_LAYER_SETTING_TYPE_STRING_EXT, 1, &families_});
     if (!report_.empty()) {
@@ -65,6 +70,7 @@ class RunSettings {
   VkBool32 protect_;
   const char* families_;
   std::string report_;
+  const char* duplicate_limit_;
   const char* report_ptr_ = nullptr;
   std::vector<VkLayerSettingEXT> settings_;
   VkLayerSettingsCreateInfoEXT info_{};
@@ -121,8 +127,8 @@ class NoticeListener {
 class ProtectRun {
  public:
   explicit ProtectRun(const char* families = nullptr, bool protect = true, const std::string& report = "",
-                      bool settings_chain = true)
-      : settings_(protect, families, report),
+                      bool settings_chain = true, const char* duplicate_limit = nullptr)
+      : settings_(protect, families, report, duplicate_limit),
         fixture_(std::make_unique<Fixture>(settings_chain ? settings_.Chain() : nullptr)),
         notices_(std::make_unique<NoticeListener>(fixture_->instance().handle())) {}
   ~ProtectRun() { Close(); }
@@ -390,6 +396,33 @@ TEST_CASE("protect: vkQueueSubmit2 and a primary executing a marked secondary ar
   CHECK(again.signaled);
   CHECK(run.TakeFindings() == Strings{});
   CHECK(run.TakeNotices() == Strings{});
+}
+
+TEST_CASE("protect: past the duplicate message limit an error is no longer reported, but its command is still "
+          "withheld and named",
+          "[integration][protect]") {
+  const RecordCase c = RecordCases()[3];  // alignment
+  ProtectRun run(c.family, true, "", true, /*duplicate_limit=*/"1");
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  Commands commands(device);
+  VkCommandBuffer first = commands.Begin();
+  c.record(device, scene, first);
+  commands.End(first);
+  CHECK(run.TakeFindings() == Strings{c.vuid});
+  CHECK(run.TakeNotices().size() == 1);
+  VkCommandBuffer second = commands.Begin();
+  c.record(device, scene, second);
+  commands.End(second);
+  CHECK(run.TakeFindings() == Strings{});  // over the limit: not reported again
+  const Strings notices = run.TakeNotices();
+  REQUIRE(notices.size() == 1);
+  CHECK(Contains(notices[0], c.vuid));
+  const Outcome outcome = SubmitWithFence(device, second);
+  CHECK(outcome.result == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK_FALSE(outcome.signaled);
+  CheckMarkedSubmissionNotice(run.TakeNotices(), "pSubmits[0].pCommandBuffers[0]", c);
+  CheckValidSubmissionRuns(run, scene);
 }
 
 // A submission asval finds invalid in execution order: withheld with VK_ERROR_VALIDATION_FAILED_EXT, its fence left
