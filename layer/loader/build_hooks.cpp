@@ -48,7 +48,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresKHR(
   cmd.infos = pInfos;
   cmd.ranges = ppBuildRangeInfos;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) {
     return WithholdRecordedCommand(*data, cmd.function, commandBuffer, protect);
   }
@@ -73,7 +73,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   cmd.indirect_strides = pIndirectStrides;
   cmd.max_primitive_counts = ppMaxPrimitiveCounts;
   const CheckThreadLease thread;  // the call's one thread_local access, for the checks and the recorder
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) {
     return WithholdRecordedCommand(*data, cmd.function, commandBuffer, protect);
   }
@@ -121,7 +121,7 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
     cmd.host_captured = capture.captured_or_null();
   }
   // Skipped by the app's callback, or withheld by protect mode: the build did not happen.
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return WithholdHostCommand(*data, cmd.function, device, protect);
   const VkResult result =
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);

@@ -23,7 +23,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
   const uint32_t warnings = settings.capture_warnings;
   const uint32_t spacing_permille = warnings & kCaptureWarnFloatSpacing ? settings.capture_float_spacing_permille : 0;
   // Protect mode: an error judged now is about work that already ran; later submissions are withheld instead.
-  const ProtectScope protect;
+  const ProtectScope protect(data.reporter->protects());
   data.capture_tracker->Process(covered, [&](SubmissionCaptures& done) {
     for (const std::shared_ptr<BuildActivity>& activity : done.fills) {
       activity->Fill(spacing_permille);

@@ -17,7 +17,7 @@ template <typename MakeOps, typename Validate, typename Downcall>
 VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR deferred, MakeOps&& make_ops,
                   Validate&& validate, Downcall&& downcall) {
   const CheckContext ctx = MakeCheckContext(data);
-  const ProtectScope protect;
+  const ProtectScope protect(data.reporter->protects());
   bool skip = ctx.Enabled(kCheckCopies) && validate(ctx);
   OpBatch batch;
   if (data.state.history_tracked) batch = make_ops();
@@ -44,7 +44,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureKHR(VkCommandBuffer comma
                                                            const VkCopyAccelerationStructureInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyInfo(ctx, "vkCmdCopyAccelerationStructureKHR", commandBuffer, *pInfo)) {
     return WithholdRecordedCommand(*data, "vkCmdCopyAccelerationStructureKHR", commandBuffer, protect);
@@ -57,7 +57,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyAccelerationStructureToMemoryKHR(
     VkCommandBuffer commandBuffer, const VkCopyAccelerationStructureToMemoryInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyToMemoryInfo(ctx, "vkCmdCopyAccelerationStructureToMemoryKHR", commandBuffer, *pInfo)) {
     return WithholdRecordedCommand(*data, "vkCmdCopyAccelerationStructureToMemoryKHR", commandBuffer, protect);
@@ -73,7 +73,7 @@ VKAPI_ATTR void VKAPI_CALL CmdCopyMemoryToAccelerationStructureKHR(
     VkCommandBuffer commandBuffer, const VkCopyMemoryToAccelerationStructureInfoKHR* pInfo) {
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (pInfo && ctx.Enabled(kCheckCopies) &&
       ValidateCopyMemoryToInfo(ctx, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, *pInfo)) {
     return WithholdRecordedCommand(*data, "vkCmdCopyMemoryToAccelerationStructureKHR", commandBuffer, protect);
@@ -91,7 +91,7 @@ VKAPI_ATTR void VKAPI_CALL CmdWriteAccelerationStructuresPropertiesKHR(
   DeviceData* data = GetDeviceData(commandBuffer);
   const CheckContext ctx = MakeCheckContext(*data);
   const char* function = "vkCmdWriteAccelerationStructuresPropertiesKHR";
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   if (ctx.Enabled(kCheckCopies) &&
       ValidateWriteProperties(ctx, function, commandBuffer, accelerationStructureCount, pAccelerationStructures,
                               queryType, queryPool, firstQuery)) {
@@ -144,7 +144,7 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
   DeviceData* data = GetDeviceData(device);
   const char* function = "vkWriteAccelerationStructuresPropertiesKHR";
   const CheckContext ctx = MakeCheckContext(*data);
-  const ProtectScope protect;
+  const ProtectScope protect(data->reporter->protects());
   bool skip = ctx.Enabled(kCheckCopies) &&
               ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount,
                                       pAccelerationStructures, queryType, VK_NULL_HANDLE, 0);

@@ -50,7 +50,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   for_each_command_buffer(
       [&](VkCommandBuffer cb, const Location& loc) { submission.Apply(cb, checks.For(cb, loc)); });
   submission.EndApply();
-  const ProtectScope protect;
+  const ProtectScope protect(data.reporter->protects());
   if (checks.ReportAll()) {
     submission.Undo();
     if (protect.withheld()) {

@@ -6,9 +6,15 @@ namespace {
 thread_local ProtectScope* t_current = nullptr;
 }  // namespace
 
-ProtectScope::ProtectScope() : outer_(t_current) { t_current = this; }
+ProtectScope::ProtectScope(bool active) : active_(active) {
+  if (!active_) return;
+  outer_ = t_current;
+  t_current = this;
+}
 
-ProtectScope::~ProtectScope() { t_current = outer_; }
+ProtectScope::~ProtectScope() {
+  if (active_) t_current = outer_;
+}
 
 void ProtectScope::NoteError(std::string_view vuid, const Location& loc) {
   ProtectScope* scope = t_current;

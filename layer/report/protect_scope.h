@@ -5,8 +5,9 @@
 // protected call from one the app's callback asked to skip (VK_TRUE), which is not marked or announced.
 //
 // One scope per thread is current; scopes nest (an app callback that calls Vulkan from inside a report opens its
-// own, and the outer one is current again when it closes). Opening one costs two thread-local stores: no
-// allocation until an error is noted.
+// own, and the outer one is current again when it closes). A scope opened with protect mode off is inert and
+// touches no thread-local storage (the hooks' one thread-local access is CheckThreadLease's); an active one costs
+// two thread-local stores, and no allocation until an error is noted.
 #include <string>
 #include <string_view>
 
@@ -16,7 +17,8 @@ namespace asval {
 
 class ProtectScope {
  public:
-  ProtectScope();
+  // `active`: protect mode is on (Reporter::protects()).
+  explicit ProtectScope(bool active);
   ~ProtectScope();
   ProtectScope(const ProtectScope&) = delete;
   ProtectScope& operator=(const ProtectScope&) = delete;
@@ -35,7 +37,8 @@ class ProtectScope {
   static void NoteError(std::string_view vuid, const Location& loc);
 
  private:
-  ProtectScope* outer_;
+  const bool active_;
+  ProtectScope* outer_ = nullptr;
   bool withheld_ = false;
   const char* function_ = "";
   std::string vuid_;
