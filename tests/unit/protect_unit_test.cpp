@@ -32,7 +32,8 @@ struct FakeDispatchable {
 };
 int g_table;  // its address is the dispatch key shared by the fake device, queue and command buffers
 FakeDispatchable g_device_object{&g_table}, g_queue_object{&g_table};
-FakeDispatchable g_cb_objects[5] = {{&g_table}, {&g_table}, {&g_table}, {&g_table}, {&g_table}};  // 4: never allocated
+// 0, 1, 3: primary; 2, 5: secondary; 4: never allocated.
+FakeDispatchable g_cb_objects[6] = {{&g_table}, {&g_table}, {&g_table}, {&g_table}, {&g_table}, {&g_table}};
 
 // What arrived at the driver.
 struct Calls {
@@ -169,7 +170,7 @@ ReportSettings Protect(bool on = true) {
 // A device registered with the layer over the fake driver: every family on, every feature enabled, the limits of a
 // typical desktop GPU. It holds BLAS a (built by the tests), b (a copy destination), c (on a buffer that can also
 // serve as scratch: the aliasing case), ha/hb (on host-visible memory, for host commands), a vertex buffer, a scratch
-// buffer, an indirect buffer, and four command buffers: 0, 1 and 3 primary, 2 secondary.
+// buffer, an indirect buffer, and command buffers 0, 1 and 3 (primary), 2 and 5 (secondary), 4 (never allocated).
 class FakeDevice {
  public:
   explicit FakeDevice(ReportSettings settings, VkBool32 answer = VK_FALSE) {
@@ -333,11 +334,11 @@ class FakeDevice {
                                                                Fake<VkCommandPool>(3), VK_COMMAND_BUFFER_LEVEL_PRIMARY,
                                                                3},
                                    primaries);
-    const VkCommandBuffer secondary = cb(2);
+    const VkCommandBuffer secondaries[] = {cb(2), cb(5)};
     state.command_buffers.Allocate(VkCommandBufferAllocateInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr,
                                                                Fake<VkCommandPool>(3),
-                                                               VK_COMMAND_BUFFER_LEVEL_SECONDARY, 1},
-                                   &secondary);
+                                                               VK_COMMAND_BUFFER_LEVEL_SECONDARY, 2},
+                                   secondaries);
   }
 
   // A buffer on memory of its own (memory type `type`), with SHADER_DEVICE_ADDRESS added to `usage`.
@@ -918,6 +919,24 @@ void ExpectMarkClearedBy(const std::function<void(FakeDevice&)>& reset) {
   CHECK(d.Notices().empty());
 }
 
+TEST_CASE("protect: the mark passes through nested secondaries (VK_EXT_nested_command_buffer)", "[protect]") {
+  FakeDevice d(Protect());
+  d.Begin(5);
+  RecordInvalidBuild(d, 5);
+  d.End(5);
+  const VkCommandBuffer inner = FakeDevice::cb(5), outer = FakeDevice::cb(2);
+  d.Begin(2);
+  hooks::CmdExecuteCommands(outer, 1, &inner);
+  d.End(2);
+  d.Begin(0);
+  hooks::CmdExecuteCommands(FakeDevice::cb(0), 1, &outer);
+  d.End(0);
+  REQUIRE(d.Withheld(0));
+  CHECK(d.Withheld(0)->vuid == kInvalidBuildVuid);
+  CHECK(d.Submit(0) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(g_calls.queue_submit == 0);
+}
+
 TEST_CASE("protect: vkResetCommandBuffer clears the mark", "[protect]") {
   ExpectMarkClearedBy([](FakeDevice& d) {
     REQUIRE(hooks::ResetCommandBuffer(FakeDevice::cb(0), 0) == VK_SUCCESS);
@@ -1175,11 +1194,16 @@ TEST_CASE("protect: the JSON report has one ASVAL-Protect-Withheld line per with
     hooks::DestroyDevice(FakeDevice::device(), nullptr);
   }  // the reporter (and its file) closes with the instance
   int notices = 0, errors = 0, summaries = 0;
+  std::vector<std::string> notice_functions;
   for (const std::string& line : report.Lines()) {
     INFO(asval_test_common::Printable(line));
     const nlohmann::json j = nlohmann::json::parse(line);
     const std::string vuid = j.value("vuid", "");
-    if (vuid == kNotice) ++notices;
+    if (vuid == kNotice) {
+      ++notices;
+      CHECK(j.value("severity", "") == "info");
+      notice_functions.push_back(j.value("function", ""));
+    }
     if (vuid == kInvalidBuildVuid || vuid == "VUID-vkBuildAccelerationStructuresKHR-pInfos-03725") ++errors;
     if (vuid == "ASVAL-History-Summary" &&
         j.value("message", "").find("recorded_commands_withheld=2 submissions_withheld=1 host_commands_withheld=1") !=
@@ -1188,6 +1212,9 @@ TEST_CASE("protect: the JSON report has one ASVAL-Protect-Withheld line per with
     }
   }
   CHECK(notices == 4);  // two recorded commands, one submission, one host build
+  CHECK(notice_functions ==
+        std::vector<std::string>{"vkCmdBuildAccelerationStructuresKHR", "vkCmdBuildAccelerationStructuresKHR",
+                                 "vkQueueSubmit", "vkBuildAccelerationStructuresKHR"});
   CHECK(errors == 3);   // the errors themselves: two recorded, one host
   CHECK(summaries == 1);
 }
