@@ -66,15 +66,25 @@ for line in open(os.path.join(out, "faults.txt")):
     else:
         message = "-"
     detected += 1 if hit else 0
-    rows.append((fault, vuid.replace("VUID-", ""), "yes" if hit else "no", message))
-widths = [max(len(r[i]) for r in rows + [("fault", "expected VUID", "reported", "")]) for i in range(3)]
-head = ("fault", "expected VUID", "reported", "message")
+    # What protect mode (on in asval-run) kept from the driver: the command, its submission, or (for faults found
+    # when the work completed) the submissions after it.
+    def kind(notice):
+        if "when the work that broke the rule completed" in notice.get("message", ""):
+            return "halt"
+        function = notice.get("function", "")
+        return "cmd" if function.startswith("vkCmd") else "submit" if function.startswith("vkQueue") else "host"
+    kept = "+".join(kind(f) for f in findings if f.get("vuid") == "ASVAL-Protect-Withheld") or "-"
+    rows.append((fault, vuid.replace("VUID-", ""), "yes" if hit else "no", kept, message))
+head = ("fault", "expected VUID", "reported", "withheld", "message")
+widths = [max(len(r[i]) for r in rows + [head]) for i in range(4)]
 print("| " + " | ".join(h.ljust(w) for h, w in zip(head, widths + [0])) + " |")
 print("|" + "|".join("-" * (w + 2) for w in widths + [7]) + "|")
 for r in rows:
-    m = r[3] if len(r[3]) <= 140 else r[3][:137] + "..."
-    print("| " + " | ".join(c.ljust(w) for c, w in zip(r[:3], widths)) + " | " + m + " |")
+    m = r[4] if len(r[4]) <= 120 else r[4][:117] + "..."
+    print("| " + " | ".join(c.ljust(w) for c, w in zip(r[:4], widths)) + " | " + m + " |")
 print()
 print("%d of %d faults reported by asval with their exact VUID. 'no': asval has no check for that rule yet" % (detected, len(rows)))
 print("(docs/coverage.md lists what is checked). The scene's image: %s" % os.path.join(out, "scene.png"))
+print("withheld: what asval's protect mode kept from the driver (cmd: the command; submit: a submission; halt: the")
+print("fault ran, found when it completed, so later submissions are withheld; docs/protect.md).")
 PY
