@@ -27,6 +27,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "history_helpers.h"
@@ -778,6 +779,61 @@ TEST_CASE("protect: the JSON report holds every finding and every notice, one li
                 "error VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581 "
                 "vkBuildAccelerationStructuresKHR",
                 "info ASVAL-Protect-Withheld vkBuildAccelerationStructuresKHR"});
+}
+
+// Threads: four threads record at once (a pool each), some commands withheld, and submit under the app's queue lock
+// (vkQueueSubmit's queue is externally synchronized): each submission gets its own verdict, marks never leak to
+// another thread's command buffers, and every withheld call is named once. The tsan build runs it ([threads]).
+TEST_CASE("protect: threads recording withheld and valid commands at once each get their own verdicts",
+          "[integration][protect][threads]") {
+  constexpr int kThreads = 4, kJobs = 24;
+  ProtectRun run("alignment", /*protect=*/true, "", /*settings_chain=*/true, /*duplicate_limit=*/"0");
+  vkkit::Device& device = run.device();
+  Scene scene(device);
+  std::vector<std::unique_ptr<TriangleInfo>> builds;  // one destination and scratch per thread
+  for (int t = 0; t < kThreads; ++t) builds.push_back(std::make_unique<TriangleInfo>(scene));
+  const VkDeviceSize misalign = device.as_properties().minAccelerationStructureScratchOffsetAlignment / 2;
+  REQUIRE(misalign > 0);
+  std::mutex queue_mutex;
+  std::vector<std::string> problems(kThreads);
+  auto work = [&](int t) {
+    Commands commands(device);
+    const TriangleInfo& valid = *builds[t];
+    VkAccelerationStructureBuildGeometryInfoKHR invalid = valid.info;
+    invalid.scratchData.deviceAddress += misalign;  // pInfos-03710
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &valid.range;
+    for (int j = 0; j < kJobs; ++j) {
+      const bool withheld = (j + t) % 3 == 0;
+      VkCommandBuffer cb = commands.Begin();
+      device.CmdBuildAccelerationStructuresKHR(cb, 1, withheld ? &invalid : &valid.info, &ranges);
+      commands.End(cb);
+      VkResult result;
+      {
+        std::lock_guard lock(queue_mutex);
+        result = commands.Submit(cb);
+      }
+      const VkResult expected = withheld ? VK_ERROR_VALIDATION_FAILED_EXT : VK_SUCCESS;
+      if (result != expected && problems[t].empty()) {
+        problems[t] = "thread " + std::to_string(t) + " job " + std::to_string(j) + ": VkResult " +
+                      std::to_string(result);
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) threads.emplace_back(work, t);
+  for (std::thread& thread : threads) thread.join();
+  CHECK(problems == Strings(kThreads));
+  int withheld_jobs = 0;
+  for (int t = 0; t < kThreads; ++t) {
+    for (int j = 0; j < kJobs; ++j) withheld_jobs += (j + t) % 3 == 0;
+  }
+  CHECK(run.TakeFindings() ==
+        Strings(static_cast<size_t>(withheld_jobs), "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03710"));
+  const Strings notices = run.TakeNotices();
+  CHECK(notices.size() == static_cast<size_t>(2 * withheld_jobs));  // the command, then its submission
+  CHECK(std::count_if(notices.begin(), notices.end(), [](const std::string& n) {
+          return Contains(n, "lacks a command asval withheld");
+        }) == withheld_jobs);
 }
 
 }  // namespace
