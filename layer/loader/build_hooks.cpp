@@ -122,7 +122,9 @@ VKAPI_ATTR VkResult VKAPI_CALL BuildAccelerationStructuresKHR(
   }
   // Skipped by the app's callback, or withheld by protect mode: the build did not happen.
   const ProtectScope protect(data->reporter->protects());
-  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) return WithholdHostCommand(*data, cmd.function, device, protect);
+  if (ValidateBuildCommand(MakeCheckContext(*data), cmd)) {
+    return WithholdHostCommand(*data, cmd.function, device, protect);
+  }
   const VkResult result =
       data->dispatch.BuildAccelerationStructuresKHR(device, deferredOperation, infoCount, pInfos, ppBuildRangeInfos);
   // History: applied now on success, or when the deferred operation completes.
