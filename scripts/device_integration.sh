@@ -6,7 +6,8 @@
 #   .devrun/  layer/ (stripped libVkLayer_asval_as_validation.so and its build-tree manifest),
 #             asval_integration_tests (stripped), lib/libfmt.so.9.
 # Call: run(command="bash scripts/device_integration.sh", carry=[".gl", ".devrun"]). Failures land in
-# $OUT/failures.txt.
+# $OUT/failures.txt. An argument narrows the run further (a Catch2 test spec, e.g. "[protect]"); the tests that pass
+# invalid calls down stay out whatever it says.
 for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
 export LD_LIBRARY_PATH=$PWD/.devrun/lib
 if ! ls /usr/share/vulkan/icd.d/nvidia_icd.json >/dev/null 2>&1 && ! ls /etc/vulkan/icd.d/nvidia_icd.json >/dev/null 2>&1; then
@@ -16,7 +17,7 @@ export VK_LAYER_PATH=$PWD/.devrun/layer VK_LOADER_LAYERS_DISABLE='~implicit~'
 export XDG_DATA_HOME=/tmp/xdg HOME=/tmp/xdg VK_LAYER_SETTINGS_PATH=/tmp/xdg/none; mkdir -p /tmp/xdg
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 bin=.devrun/asval_integration_tests
-$bin --list-tests --verbosity quiet "~[passes-invalid-down]" > /tmp/names.txt
+$bin --list-tests --verbosity quiet "${1:-}~[passes-invalid-down]" > /tmp/names.txt
 echo "$(wc -l < /tmp/names.txt) test cases"
 pass=0; fail=0; : > $OUT/failures.txt
 while IFS= read -r name; do
