@@ -16,6 +16,11 @@ std::string Cause(const std::string& vuid, const std::string& where) {
   return fmt::format("{} ({})", vuid, where);
 }
 
+// What every withheld submission's notice says happened to it (the text goes on after it).
+constexpr const char kSubmissionNotPassedDown[] =
+    "the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; its fence "
+    "and semaphores are not signaled";
+
 }  // namespace
 
 void ReportWithheldCommand(const CheckContext& ctx, const char* function, VkCommandBuffer cb,
@@ -43,20 +48,16 @@ void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, V
                               const WithheldCommand& command) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, cb_loc, {Obj(VK_OBJECT_TYPE_QUEUE, queue), Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb)},
-      fmt::format("lacks a command asval withheld when it was recorded ({}, for {}). protect: the submission was "
-                  "not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; its fence and "
-                  "semaphores are not signaled).",
-                  command.function, Cause(command.vuid, command.where)));
+      fmt::format("lacks a command asval withheld when it was recorded ({}, for {}). protect: {}).", command.function,
+                  Cause(command.vuid, command.where), kSubmissionNotPassedDown));
 }
 
 void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
                               const ProtectScope& cause) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_QUEUE, queue)},
-      fmt::format("protect: the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT "
-                  "(nothing of it ran; its fence and semaphores are not signaled; the build history is as before "
-                  "it) because asval reported {} in execution order.",
-                  Cause(cause.vuid(), cause.where())));
+      fmt::format("protect: {}; the build history is as before it) because asval reported {} in execution order.",
+                  kSubmissionNotPassedDown, Cause(cause.vuid(), cause.where())));
 }
 
 void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause) {
@@ -72,10 +73,9 @@ void ReportHaltedSubmission(const CheckContext& ctx, const char* function, VkQue
                             const WithheldCommand& cause) {
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_QUEUE, queue)},
-      fmt::format("protect: the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing "
-                  "of it ran; its fence and semaphores are not signaled) because an earlier submission broke a rule "
-                  "found when it completed: {}. Every submission on this device since is withheld.",
-                  Cause(cause.vuid, cause.where)));
+      fmt::format("protect: {}) because an earlier submission broke a rule found when it completed: {}. Every "
+                  "submission on this device since is withheld.",
+                  kSubmissionNotPassedDown, Cause(cause.vuid, cause.where)));
 }
 
 void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {

@@ -14,21 +14,6 @@ namespace asval::hooks {
 
 namespace {
 
-// Protect mode: true when a submitted command buffer holds a command the layer withheld (the first is named).
-template <typename ForEachCommandBuffer>
-bool WithholdMarkedCommandBuffers(DeviceData& data, VkQueue queue, ForEachCommandBuffer&& for_each_command_buffer) {
-  bool withheld = false;
-  for_each_command_buffer([&](VkCommandBuffer cb, const Location& loc) {
-    if (withheld) return;
-    if (const std::shared_ptr<const WithheldCommand> command = data.state.command_buffers.Withheld(cb)) {
-      withheld = true;
-      RecordWithheldSubmission(data.state);
-      ReportWithheldSubmission(MakeCheckContext(data), loc, queue, cb, *command);
-    }
-  });
-  return withheld;
-}
-
 // for_each_command_buffer(visit) calls visit(cb, location) for every submitted command buffer, in order.
 template <typename ForEachCommandBuffer, typename Downcall>
 VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence fence,
@@ -36,13 +21,8 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
-  if (data.reporter->protects()) {
-    if (const std::shared_ptr<const WithheldCommand> halt = data.state.protect_halt.Cause()) {
-      RecordWithheldSubmission(data.state);
-      ReportHaltedSubmission(MakeCheckContext(data), function, queue, *halt);
-      return VK_ERROR_VALIDATION_FAILED_EXT;
-    }
-    if (WithholdMarkedCommandBuffers(data, queue, for_each_command_buffer)) return VK_ERROR_VALIDATION_FAILED_EXT;
+  if (data.reporter->protects() && WithholdSubmission(data, function, queue, for_each_command_buffer)) {
+    return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   const CheckContext ctx = MakeCheckContext(data);
   HistorySubmission submission(data.state);

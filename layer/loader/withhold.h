@@ -28,6 +28,29 @@ inline VkResult WithholdHostCommand(DeviceData& data, const char* function, VkDe
   return VK_ERROR_VALIDATION_FAILED_EXT;
 }
 
+// Protect mode, before a submission is applied: true when it must be withheld whole, because submissions are halted
+// (HaltSubmissionsAfter) or a submitted command buffer holds a command the layer withheld (the first is named).
+// for_each_command_buffer(visit) calls visit(cb, location) for every submitted command buffer, in order.
+template <typename ForEachCommandBuffer>
+bool WithholdSubmission(DeviceData& data, const char* function, VkQueue queue,
+                        ForEachCommandBuffer&& for_each_command_buffer) {
+  if (const std::shared_ptr<const WithheldCommand> halt = data.state.protect_halt.Cause()) {
+    RecordWithheldSubmission(data.state);
+    ReportHaltedSubmission(MakeCheckContext(data), function, queue, *halt);
+    return true;
+  }
+  bool withheld = false;
+  for_each_command_buffer([&](VkCommandBuffer cb, const Location& loc) {
+    if (withheld) return;
+    if (const std::shared_ptr<const WithheldCommand> command = data.state.command_buffers.Withheld(cb)) {
+      withheld = true;
+      RecordWithheldSubmission(data.state);
+      ReportWithheldSubmission(MakeCheckContext(data), loc, queue, cb, *command);
+    }
+  });
+  return withheld;
+}
+
 // Errors judged at completion (execution-time capture) while `protect` was open: the work already ran, so every
 // later submission on the device is withheld (named once here, and in each submission's notice).
 inline void HaltSubmissionsAfter(DeviceData& data, const ProtectScope& protect) {
