@@ -54,6 +54,17 @@ struct Referenced {
                      DescribeOrigin(c.build), Hex(c.dst), geometry, bad, named));
 }
 
+[[gnu::cold]] void ReportTopLevel(const CheckContext& ctx, const InstanceReferenceCheck& c, uint32_t geometry,
+                                   uint64_t count, const std::string& named) {
+  Report(ctx, c, "pInfos-06707", VK_NULL_HANDLE,
+         fmt::format("{}: builds top-level {}; on execution, geometry {}: {} instance(s) reference a top-level "
+                     "acceleration structure, but an instance must reference a bottom-level one (the top level takes "
+                     "a reference to the bottom-level structures its instances reference; the indirect command's "
+                     "newest text of this rule, pInfos-12281, says \"a valid bottom level acceleration "
+                     "structure\"): {}.",
+                     DescribeOrigin(c.build), Hex(c.dst), geometry, count, named));
+}
+
 // "geometry 0, instance 3 references VkAccelerationStructureKHR 0x... (address 0x...)".
 std::string Referencing(const Referenced& r, const AccelerationStructureState& s) {
   return fmt::format("geometry {}, instance {} references VkAccelerationStructureKHR {} (address 0x{:x})", r.geometry,
@@ -169,6 +180,8 @@ void CheckInstancePointers(const CheckContext& ctx, const InstanceReferenceCheck
                      DescribeOrigin(c.build), Hex(c.dst), geometry, misaligned, named));
 }
 
+bool BottomLevel(const AccelerationStructureState& s) { return s.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR; }
+
 // A reduced geometry's references judged by their summaries (ReducedGeometry::Distinct): true when each names a
 // live structure, `first` (when asked) then holding, per structure, the first instance referencing it (the first
 // 64-record group that holds a reference holds its first record). False when one does not: the caller walks the
@@ -182,7 +195,7 @@ bool JudgeDistinctReferences(const ReducedGeometry& reduced, const LiveStructure
       uint32_t instance = 0;
       reduced.DistinctReference(group, e, &reference, &instance);
       const std::ptrdiff_t structure = live.Find(reference);
-      if (structure < 0) return false;
+      if (structure < 0 || !BottomLevel(*live.structures[static_cast<std::size_t>(structure)])) return false;
       if (first && (*first)[static_cast<std::size_t>(structure)].structure < 0) {
         (*first)[static_cast<std::size_t>(structure)] = Referenced{structure, geometry, instance};
       }
@@ -224,8 +237,10 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     const uint8_t* references = log->Bytes(g.data) + (g.reduced ? 0 : kReferenceOffset);
     const VkDeviceSize stride = g.reduced ? sizeof(uint64_t) : kInstanceBytes;
     uint64_t bad = 0;
+    uint64_t top_level = 0;
     bool unknown = false;
     std::string named;
+    std::string named_top_level;
     // Instances come in runs of the same structure, or cycle through a few: the last reference, and a small table
     // of those looked up (by a multiplicative hash: structure addresses share their low bits), spare most lookups.
     constexpr uint32_t kRememberedBits = 6;
@@ -247,8 +262,19 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
         last = reference;
       }
       if (structure >= 0) {
+        const AccelerationStructureState& s = *live.structures[static_cast<std::size_t>(structure)];
         if (per_structure && first[static_cast<std::size_t>(structure)].structure < 0) {
           first[static_cast<std::size_t>(structure)] = Referenced{structure, j, k};
+        }
+        if (BottomLevel(s)) continue;
+        // A generic structure is bottom- or top-level as its last build made it: not judged.
+        if (s.type != VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+          unknown = true;
+          continue;
+        }
+        if (top_level++ < kNamed) {
+          named_top_level += fmt::format("{}instance {} references VkAccelerationStructureKHR {} (address 0x{:x})",
+                                         top_level > 1 ? ", " : "", k, Hex(s.handle), s.device_address);
         }
         continue;
       }
@@ -261,6 +287,8 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     if (unknown) CountUnknownState(ctx);
     if (bad > kNamed) named += fmt::format(" (and {} more)", bad - kNamed);
     if (bad != 0) ReportStale(ctx, c, j, bad, named);
+    if (top_level > kNamed) named_top_level += fmt::format(" (and {} more)", top_level - kNamed);
+    if (top_level != 0) ReportTopLevel(ctx, c, j, top_level, named_top_level);
   }
   // Each referenced structure once, named by the first instance that references it.
   uint32_t findings = 0;
@@ -268,7 +296,10 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     if (r.structure < 0) continue;
     const auto k = static_cast<std::size_t>(r.structure);
     const std::shared_ptr<const AccelerationStructureState>& structure = live.structures[k];
-    if (k < c.activities.size() && c.activities[k] && c.activities[k]->NoActivePrimitive()) {
+    // Several bound structures at this address: which one the instance meant, and so its activity, is not known.
+    if (k < c.activities.size() && c.activities[k] && live.shared[k]) {
+      CountUnknownState(ctx);
+    } else if (k < c.activities.size() && c.activities[k] && c.activities[k]->NoActivePrimitive()) {
       ReportDegenerateInstance(ctx, c, r.geometry, r.instance, structure->handle, structure->device_address);
     }
     if (findings >= kMaxStructureFindings) continue;

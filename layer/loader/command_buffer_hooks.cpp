@@ -19,7 +19,11 @@ VKAPI_ATTR void VKAPI_CALL DestroyCommandPool(VkDevice device, VkCommandPool com
                                               const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
   // Before the downcall: see CommandBufferMap::DestroyPool.
-  if (commandPool) data->state.command_buffers.DestroyPool(commandPool);
+  if (commandPool) {
+    data->state.command_buffers.DestroyPool(commandPool, [&](VkCommandBuffer cb) {
+      data->reporter->ForgetObjectName(Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, cb));
+    });
+  }
   data->dispatch.DestroyCommandPool(device, commandPool, pAllocator);
 }
 
@@ -44,6 +48,9 @@ VKAPI_ATTR void VKAPI_CALL FreeCommandBuffers(VkDevice device, VkCommandPool com
   DeviceData* data = GetDeviceData(device);
   // Before the downcall, for the same reason as in DestroyCommandPool.
   data->state.command_buffers.Free(commandBufferCount, pCommandBuffers);
+  for (uint32_t i = 0; pCommandBuffers && i < commandBufferCount; ++i) {
+    if (pCommandBuffers[i]) data->reporter->ForgetObjectName(Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, pCommandBuffers[i]));
+  }
   data->dispatch.FreeCommandBuffers(device, commandPool, commandBufferCount, pCommandBuffers);
 }
 

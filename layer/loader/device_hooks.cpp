@@ -27,6 +27,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
   }
+  if (data) data->reporter->ForgetObjectNames(device);  // its queues' and its objects' left undestroyed
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
 }
 
@@ -34,7 +35,9 @@ VKAPI_ATTR VkResult VKAPI_CALL SetDebugUtilsObjectNameEXT(VkDevice device,
                                                           const VkDebugUtilsObjectNameInfoEXT* pNameInfo) {
   DeviceData* data = GetDeviceData(device);
   if (!data) return VK_ERROR_INITIALIZATION_FAILED;
-  if (pNameInfo) data->reporter->SetObjectName(pNameInfo->objectHandle, pNameInfo->pObjectName);
+  if (pNameInfo) {
+    data->reporter->SetObjectName(device, pNameInfo->objectType, pNameInfo->objectHandle, pNameInfo->pObjectName);
+  }
   // Always passed down: when the device chain has no entry for it (VK_EXT_debug_utils is an instance
   // extension), CreateDevice filled the table from the next element's instance-level entry point.
   if (!data->dispatch.SetDebugUtilsObjectNameEXT) return VK_ERROR_EXTENSION_NOT_PRESENT;  // never handed out then
@@ -118,7 +121,10 @@ VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
                                                            const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
   // Before the downcall: afterwards the handle value may be handed out again by another thread.
-  if (accelerationStructure) RecordDestroyAccelerationStructure(data->state, accelerationStructure);
+  if (accelerationStructure) {
+    RecordDestroyAccelerationStructure(data->state, accelerationStructure);
+    data->reporter->ForgetObjectName(Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, accelerationStructure));
+  }
   data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
 }
 

@@ -75,19 +75,53 @@ void Reporter::RemoveMessenger(VkDebugUtilsMessengerEXT handle) {
   }
 }
 
-void Reporter::SetObjectName(uint64_t handle, const char* name) {
-  std::unique_lock lock(names_mutex_);
-  if (!name || !*name) {
-    names_.erase(handle);
-  } else {
-    names_[handle] = name;
+bool Reporter::KeepsNameOf(VkObjectType type) {
+  // The types asval's messages name (ReportObject), each of which the layer sees end.
+  switch (type) {
+    case VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR:  // vkDestroyAccelerationStructureKHR
+    case VK_OBJECT_TYPE_COMMAND_BUFFER:              // vkFreeCommandBuffers, vkDestroyCommandPool
+    case VK_OBJECT_TYPE_QUEUE:                       // vkDestroyDevice
+    case VK_OBJECT_TYPE_DEVICE:
+      return true;
+    default:
+      return false;
   }
 }
 
-std::string Reporter::ObjectName(uint64_t handle) const {
+void Reporter::SetObjectName(VkDevice device, VkObjectType type, uint64_t handle, const char* name) {
+  if (!KeepsNameOf(type)) return;
+  std::unique_lock lock(names_mutex_);
+  if (!name || !*name) {
+    names_.erase(NamedObject{type, handle});
+  } else {
+    names_[NamedObject{type, handle}] = ObjectNameEntry{device, name};
+  }
+  name_count_.store(names_.size(), std::memory_order_relaxed);
+}
+
+void Reporter::ForgetObjectName(ReportObject object) {
+  // Relaxed: a name set on another thread for an object this thread destroys would break the app's own
+  // synchronization of that object.
+  if (name_count_.load(std::memory_order_relaxed) == 0) return;
+  std::unique_lock lock(names_mutex_);
+  names_.erase(NamedObject{object.type, object.handle});
+  name_count_.store(names_.size(), std::memory_order_relaxed);
+}
+
+void Reporter::ForgetObjectNames(VkDevice device) {
+  if (name_count_.load(std::memory_order_relaxed) == 0) return;
+  std::unique_lock lock(names_mutex_);
+  for (auto it = names_.begin(); it != names_.end();) {
+    it = it->second.device == device ? names_.erase(it) : std::next(it);
+  }
+  name_count_.store(names_.size(), std::memory_order_relaxed);
+}
+
+std::string Reporter::ObjectName(VkObjectType type, uint64_t handle) const {
+  if (name_count_.load(std::memory_order_relaxed) == 0) return std::string();
   std::shared_lock lock(names_mutex_);
-  auto it = names_.find(handle);
-  return it == names_.end() ? std::string() : it->second;
+  auto it = names_.find(NamedObject{type, handle});
+  return it == names_.end() ? std::string() : it->second.name;
 }
 
 bool Reporter::SeverityEnabled(Severity s) const {
@@ -184,7 +218,7 @@ void Reporter::Deliver(Severity severity, std::string_view vuid, uint32_t hash, 
   object_infos.reserve(objects.size());
   for (const ReportObject& o : objects) {
     if (o.handle == 0) continue;
-    names.push_back(ObjectName(o.handle));
+    names.push_back(ObjectName(o.type, o.handle));
   }
   size_t name_index = 0;
   for (const ReportObject& o : objects) {
@@ -252,7 +286,7 @@ void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash
   for (const ReportObject& o : objects) {
     if (o.handle == 0) continue;
     nlohmann::ordered_json object = {{"type", ObjectTypeName(o.type)}, {"handle", Hex(o.handle)}};
-    const std::string name = ObjectName(o.handle);
+    const std::string name = ObjectName(o.type, o.handle);
     if (!name.empty()) object["name"] = name;
     json_objects.push_back(std::move(object));
   }

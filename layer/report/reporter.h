@@ -61,7 +61,15 @@ class Reporter {
   void RemoveMessenger(VkDebugUtilsMessengerEXT handle);
   void RemoveCreateTimeMessengers() { RemoveMessenger(VK_NULL_HANDLE); }
 
-  void SetObjectName(uint64_t handle, const char* name);  // null or empty name forgets it
+  // Names the app set with vkSetDebugUtilsObjectNameEXT on `device`, shown with the objects asval's messages
+  // name. Kept only for the types those messages name, each forgotten when its object ends (ForgetObjectName from
+  // the destroy and free hooks, ForgetObjectNames at vkDestroyDevice), so that per-frame objects do not grow the
+  // table and a new object given a dead one's handle value is never shown under the dead one's name. A null or empty
+  // name forgets it too.
+  void SetObjectName(VkDevice device, VkObjectType type, uint64_t handle, const char* name);
+  void ForgetObjectName(ReportObject object);  // takes no lock while no name is kept
+  void ForgetObjectNames(VkDevice device);
+  static bool KeepsNameOf(VkObjectType type);
 
   // Reports one finding. vuid may be an older spelling: the newest is reported. Returns true when the call must
   // not be passed down: a messenger callback returned VK_TRUE (the app asks the layer to skip it), or, in protect
@@ -106,7 +114,7 @@ class Reporter {
   bool SeverityEnabled(Severity s) const;
   // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
   bool CountDuplicate(uint32_t hash, bool* last);
-  std::string ObjectName(uint64_t handle) const;
+  std::string ObjectName(VkObjectType type, uint64_t handle) const;
   std::atomic<uint64_t>& CounterFor(Severity severity);
   void WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
                  std::initializer_list<ReportObject> objects, std::string_view message, std::string_view spec_text);
@@ -118,8 +126,23 @@ class Reporter {
   mutable std::shared_mutex messengers_mutex_;
   std::vector<Messenger> messengers_;
 
+  struct NamedObject {
+    VkObjectType type;
+    uint64_t handle;  // handles of different types may share a value
+    bool operator==(const NamedObject& o) const { return type == o.type && handle == o.handle; }
+  };
+  struct NamedObjectHash {
+    std::size_t operator()(const NamedObject& o) const {
+      return std::hash<uint64_t>{}(o.handle * 0x9e3779b97f4a7c15ull + static_cast<uint64_t>(o.type));
+    }
+  };
+  struct ObjectNameEntry {
+    VkDevice device;  // the object's device: its names end with it
+    std::string name;
+  };
   mutable std::shared_mutex names_mutex_;
-  std::unordered_map<uint64_t, std::string> names_;
+  std::unordered_map<NamedObject, ObjectNameEntry, NamedObjectHash> names_;
+  std::atomic<std::size_t> name_count_{0};  // names_.size(), read without the lock
 
   std::mutex duplicates_mutex_;
   std::unordered_map<uint32_t, uint32_t> duplicate_counts_;

@@ -95,12 +95,6 @@ void CommandBufferMap::CreatePool(VkCommandPool pool, VkCommandPoolCreateFlags f
   }
 }
 
-void CommandBufferMap::DestroyPool(VkCommandPool pool) {
-  std::optional<std::shared_ptr<PoolState>> record = pools_.pop(pool);
-  if (!record || !*record) return;
-  for (VkCommandBuffer cb : (*record)->buffers) buffers_.erase(cb);
-}
-
 void CommandBufferMap::ResetPool(VkCommandPool pool) {
   std::shared_ptr<PoolState> record = PoolOf(pool);
   if (!record) return;

@@ -105,7 +105,16 @@ class CommandBufferMap {
   void CreatePool(VkCommandPool pool, VkCommandPoolCreateFlags flags);
   // Forgets the pool and its command buffers (before the driver frees them: afterwards their handles may be
   // handed out again by another thread's allocation, whose records must not be erased here).
-  void DestroyPool(VkCommandPool pool);
+  // `freed(VkCommandBuffer)` is called for each of its command buffers (their names end with them).
+  template <typename Freed>
+  void DestroyPool(VkCommandPool pool, Freed&& freed) {
+    std::optional<std::shared_ptr<PoolState>> record = pools_.pop(pool);
+    if (!record || !*record) return;
+    for (VkCommandBuffer cb : (*record)->buffers) {
+      buffers_.erase(cb);
+      freed(cb);
+    }
+  }
   void ResetPool(VkCommandPool pool);
   void Allocate(const VkCommandBufferAllocateInfo& info, const VkCommandBuffer* buffers);
   void Free(uint32_t count, const VkCommandBuffer* buffers);

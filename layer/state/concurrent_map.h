@@ -103,6 +103,19 @@ class ConcurrentMap {
     return erased;
   }
 
+  // Replaces the value only while it is still `expected` (compared with ==), in one locked step: a writer that
+  // derived `value` from `expected` never overwrites a change made meanwhile (an erase, a newer record).
+  template <typename V>
+  bool replace_if(const Key& key, const T& expected, V&& value) {
+    Shard& shard = ShardFor(key);
+    std::unique_lock lock(shard.mutex);
+    const auto it = shard.map.find(key);
+    if (it == shard.map.end() || !(it->second == expected)) return false;
+    it->second = std::forward<V>(value);
+    stamp_.Bump();
+    return true;
+  }
+
   // Erases and hands back the value in one locked step, so exactly one of several racing callers gets it
   // (used by vkDestroy* to take ownership of the state being destroyed).
   std::optional<T> pop(const Key& key) {

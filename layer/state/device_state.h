@@ -80,6 +80,9 @@ class DeviceState {
   // Bumped when a buffer with ACCELERATION_STRUCTURE_STORAGE usage is bound, destroyed or has its memory freed: a
   // structure's storage may have changed (the snapshot above is taken again).
   ChangeStamp structure_storage_changes;
+  // Structures whose address the layer will ask for when their buffer is bound (Address::kAwaitingBind): while
+  // there are none, binding a storage buffer looks for nothing.
+  std::atomic<uint32_t> structures_awaiting_address{0};
   // Execution-time capture (layer/capture): what it captured, and could not; and the layer's own failures
   // (capture_counters.failures: failure_counters.h).
   mutable CaptureCounters capture_counters;

@@ -25,11 +25,15 @@ namespace asval {
 enum class StructureStorage : uint8_t { kBound, kBufferDestroyed, kMemoryFreed, kUnbound, kUnknown };
 
 struct LiveStructureAddresses {
-  std::vector<VkDeviceAddress> addresses;  // sorted
+  std::vector<VkDeviceAddress> addresses;  // sorted, each once
   // structures[k] has addresses[k] (the record as it was when the snapshot was taken), and storage[k] says
-  // whether its buffer was bound then.
+  // whether its buffer was bound then. An address is not an identity: where several live structures have one
+  // address (a structure whose buffer was destroyed, and a new one created in the same memory; two structures over
+  // one allocation), structures[k] is the one a reference to it may validly name (ByPreference), and shared[k] says
+  // that another one had the address too, bound as well: which of them a reference meant is then not known.
   std::vector<std::shared_ptr<const AccelerationStructureState>> structures;
   std::vector<StructureStorage> storage;
+  std::vector<uint8_t> shared;
   bool all_bound = true;  // every storage[k] is kBound
   // Every live structure's address is known (the layer could ask for them all): otherwise an address not found
   // may belong to a structure whose address the layer does not know, and nothing is concluded from its absence.
@@ -85,24 +89,38 @@ class LiveStructureAddressCache {
     }
     auto fresh = std::make_shared<LiveStructureAddresses>();
     if (incomplete) fresh->complete = false;
-    std::vector<std::shared_ptr<const AccelerationStructureState>> live;
+    std::vector<Candidate> live;
     for (auto& [handle, record] : structures.snapshot()) {
-      if (!record || record->device_address == 0) {
+      if (!record || record->address == AccelerationStructureState::Address::kUnknown) {
         fresh->complete = false;
         continue;
       }
-      live.push_back(std::move(record));
+      if (record->address != AccelerationStructureState::Address::kKnown) continue;  // it has no address
+      const StructureStorage storage = storage_of(*record);
+      live.push_back(Candidate{std::move(record), storage});
     }
-    std::sort(live.begin(), live.end(),
-              [](const auto& a, const auto& b) { return a->device_address < b->device_address; });
+    std::sort(live.begin(), live.end(), ByPreference);
     fresh->addresses.reserve(live.size());
     fresh->storage.reserve(live.size());
-    for (const auto& record : live) {
-      fresh->addresses.push_back(record->device_address);
-      fresh->storage.push_back(storage_of(*record));
-      fresh->all_bound &= fresh->storage.back() == StructureStorage::kBound;
+    fresh->shared.reserve(live.size());
+    std::vector<std::shared_ptr<const AccelerationStructureState>> kept;
+    kept.reserve(live.size());
+    for (std::size_t k = 0; k < live.size(); ++k) {
+      const VkDeviceAddress address = live[k].record->device_address;
+      if (!fresh->addresses.empty() && fresh->addresses.back() == address) {
+        // The first of this address is the preferred one: the others only make it shared.
+        if (live[k].storage == StructureStorage::kBound && fresh->storage.back() == StructureStorage::kBound) {
+          fresh->shared.back() = 1;
+        }
+        continue;
+      }
+      fresh->addresses.push_back(address);
+      fresh->storage.push_back(live[k].storage);
+      fresh->shared.push_back(0);
+      fresh->all_bound &= live[k].storage == StructureStorage::kBound;
+      kept.push_back(std::move(live[k].record));
     }
-    fresh->structures = std::move(live);
+    fresh->structures = std::move(kept);
     fresh->Index();
     cached_ = std::move(fresh);
     stamp_ = stamp;
@@ -111,6 +129,33 @@ class LiveStructureAddressCache {
   }
 
  private:
+  struct Candidate {
+    std::shared_ptr<const AccelerationStructureState> record;
+    StructureStorage storage;
+  };
+  // Sorted by address, and among structures with one address the one a reference to it may validly name first:
+  // storage bound (the others' storage is gone: a reference means the bound one), then known, then lost; a
+  // bottom-level one before a generic before a top-level one (instances reference bottom-level structures); then the
+  // smallest (its bytes are the ones every structure there has: overlaps judged on them are certain).
+  static bool ByPreference(const Candidate& a, const Candidate& b) {
+    if (a.record->device_address != b.record->device_address) {
+      return a.record->device_address < b.record->device_address;
+    }
+    const auto storage_rank = [](StructureStorage s) {
+      return s == StructureStorage::kBound ? 0 : s == StructureStorage::kUnknown ? 1 : 2;
+    };
+    const auto type_rank = [](VkAccelerationStructureTypeKHR t) {
+      if (t == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return 0;
+      return t == VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR ? 1 : 2;
+    };
+    if (storage_rank(a.storage) != storage_rank(b.storage)) return storage_rank(a.storage) < storage_rank(b.storage);
+    if (type_rank(a.record->type) != type_rank(b.record->type)) {
+      return type_rank(a.record->type) < type_rank(b.record->type);
+    }
+    if (a.record->size != b.record->size) return a.record->size < b.record->size;
+    return a.record->handle < b.record->handle;  // a total order: the same snapshot every time
+  }
+
   mutable std::mutex mutex_;
   mutable std::shared_ptr<const LiveStructureAddresses> cached_;
   mutable StampValue stamp_{};

@@ -49,7 +49,15 @@ struct AccelerationStructureState {
   VkDeviceSize size = 0;
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_GENERIC_KHR;
   VkAccelerationStructureCreateFlagsKHR create_flags = 0;
-  VkDeviceAddress device_address = 0;  // the layer queries it at creation when the device allows it
+  VkDeviceAddress device_address = 0;  // asked of the driver by the layer where the app itself could ask
+  // What the layer knows of the structure's address (instance references are judged against the known ones):
+  enum class Address : uint8_t {
+    kKnown,         // device_address
+    kNone,          // it has none: its buffer lacks SHADER_DEVICE_ADDRESS usage, so no instance can reference it
+    kAwaitingBind,  // its buffer was not bound when it was created: asked when the buffer is bound, none until then
+    kUnknown,       // it may have one the layer does not know (its buffer unknown or sparse, the query unavailable)
+  };
+  Address address = Address::kUnknown;
   // The buffer was bound to memory when the structure was created. A binding never goes away, so the
   // bound-memory rules (pInfos-03707/03708) need no buffer lookup for such a structure.
   bool buffer_was_bound = false;

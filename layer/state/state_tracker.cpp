@@ -108,6 +108,56 @@ void RecordFreeMemory(DeviceState& state, VkDeviceMemory memory) {
   state.history.store.ForgetMemory(memory);  // erases only
 }
 
+namespace {
+
+// Asks the driver for a structure's address, as the app may once the buffer it was created on is bound with
+// SHADER_DEVICE_ADDRESS usage (the layer's own call then breaks no rule).
+AccelerationStructureState::Address AskAddress(const DeviceDispatchTable& dispatch, VkDevice device,
+                                               AccelerationStructureState& record) {
+  using Address = AccelerationStructureState::Address;
+  if (!dispatch.GetAccelerationStructureDeviceAddressKHR) return Address::kUnknown;
+  const VkAccelerationStructureDeviceAddressInfoKHR info{
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR, nullptr, record.handle};
+  record.device_address = dispatch.GetAccelerationStructureDeviceAddressKHR(device, &info);
+  return record.device_address != 0 ? Address::kKnown : Address::kUnknown;
+}
+
+// What can be known of the address of a structure created on `buffer` (null: a buffer the layer does not know).
+AccelerationStructureState::Address AddressAtCreation(const DeviceDispatchTable& dispatch, VkDevice device,
+                                                      const BufferState* buffer, AccelerationStructureState& record) {
+  using Address = AccelerationStructureState::Address;
+  if (!buffer) return Address::kUnknown;
+  if (!(buffer->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT)) return Address::kNone;
+  // Bound by vkQueueBindSparse, which the layer does not follow: whether the app could ask is not known.
+  if (buffer->create_flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT) return Address::kUnknown;
+  if (!buffer->bound) return Address::kAwaitingBind;
+  return AskAddress(dispatch, device, record);
+}
+
+// The structures created on `buffer` (its record `bound`, just bound) before it had memory get their addresses.
+void AddressStructuresOf(DeviceState& state, const DeviceDispatchTable& dispatch, VkDevice device,
+                         const BufferState& bound) try {
+  using Address = AccelerationStructureState::Address;
+  const auto waiting = state.acceleration_structures.snapshot(
+      [&](VkAccelerationStructureKHR, const std::shared_ptr<const AccelerationStructureState>& s) {
+        return s && s->address == Address::kAwaitingBind && s->buffer == bound.handle && s->buffer_id == bound.id;
+      });
+  for (const auto& [handle, old] : waiting) {
+    auto record = std::make_shared<AccelerationStructureState>(*old);
+    record->address = AskAddress(dispatch, device, *record);
+    // Published only over the record it replaces: a thread that destroyed the structure meanwhile wins.
+    if (state.acceleration_structures.replace_if(handle, old, std::move(record))) {
+      state.structures_awaiting_address.fetch_sub(1, std::memory_order_relaxed);
+    }
+  }
+} catch (const std::bad_alloc&) {
+  // A structure left awaiting may have an address now: the snapshots of live structures are never complete again.
+  state.failures().structures_incomplete.store(true, std::memory_order_relaxed);
+  ForgetFailed(state);
+}
+
+}  // namespace
+
 void RecordCreateBuffer(DeviceState& state, const VkBufferCreateInfo& info, VkBuffer buffer, bool copyable) try {
   InjectBadAlloc(FailSite::kObjectRecord);
   auto record = std::make_shared<BufferState>();
@@ -158,8 +208,12 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
     inserted = record->device_address;
   }
   const bool storage = (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
+  std::shared_ptr<const BufferState> published = record;
   state.buffers.insert_or_assign(buffer, std::move(record));
   if (storage) state.structure_storage_changes.Bump();
+  if (storage && state.structures_awaiting_address.load(std::memory_order_relaxed) != 0) {
+    AddressStructuresOf(state, dispatch, device, *published);
+  }
   } catch (const std::bad_alloc&) {
     // Kept unbound it would be reported as such: the buffer becomes unknown instead.
     state.failures().buffers_incomplete.store(true, std::memory_order_relaxed);
@@ -181,18 +235,20 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   record->size = info.size;
   record->type = info.type;
   record->create_flags = info.createFlags;
-  // The layer asks for the address only where the app itself could (the buffer is bound and has
-  // SHADER_DEVICE_ADDRESS usage), so that its own call breaks no rule.
   std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(info.buffer);
-  if (buffer && *buffer) record->buffer_id = (*buffer)->id;
-  record->buffer_was_bound = buffer && *buffer && (*buffer)->bound;
-  if (buffer && *buffer && (*buffer)->bound && ((*buffer)->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) &&
-      dispatch.GetAccelerationStructureDeviceAddressKHR) {
-    const VkAccelerationStructureDeviceAddressInfoKHR address_info{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR, nullptr, handle};
-    record->device_address = dispatch.GetAccelerationStructureDeviceAddressKHR(device, &address_info);
-  }
+  const BufferState* known = buffer && *buffer ? buffer->get() : nullptr;
+  if (known) record->buffer_id = known->id;
+  record->buffer_was_bound = known && known->bound;
+  // The layer asks for the address only where the app itself could (the buffer is bound and has
+  // SHADER_DEVICE_ADDRESS usage), so that its own call breaks no rule; a buffer bound later is asked then.
+  record->address = AddressAtCreation(dispatch, device, known, *record);
+  const bool awaiting = record->address == AccelerationStructureState::Address::kAwaitingBind;
+  if (awaiting) state.structures_awaiting_address.fetch_add(1, std::memory_order_relaxed);
   state.acceleration_structures.insert_or_assign(handle, std::move(record));
+  if (!awaiting) return;
+  // Bound by another thread since it was looked at, before this record was there to be found: asked now.
+  std::optional<std::shared_ptr<const BufferState>> now = state.buffers.find(info.buffer);
+  if (now && *now && (*now)->id == known->id && (*now)->bound) AddressStructuresOf(state, dispatch, device, **now);
 } catch (const std::bad_alloc&) {
   // Unknown to the layer: its checks skip and count (a handle that is not a live structure the layer knows), and
   // the histories never record it (history_apply.cpp: Fresh).
@@ -202,7 +258,10 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
 }
 
 void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
-  state.acceleration_structures.erase(handle);
+  std::optional<std::shared_ptr<const AccelerationStructureState>> record = state.acceleration_structures.pop(handle);
+  if (record && *record && (*record)->address == AccelerationStructureState::Address::kAwaitingBind) {
+    state.structures_awaiting_address.fetch_sub(1, std::memory_order_relaxed);
+  }
   std::unique_lock<std::mutex> lock = state.history.store.Lock();
   try {
     state.history.store.Forget(handle);  // the record is out of the index before anything is allocated

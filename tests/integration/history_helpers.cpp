@@ -254,6 +254,21 @@ void Blas::DestroyStorageBuffer() {
   storage_.buffer = VK_NULL_HANDLE;  // ~Blas frees the memory only
 }
 
+VkAccelerationStructureKHR Blas::Relocate() {
+  if (!storage_.memory) throw std::logic_error("Blas::Relocate needs a structure with storage of its own");
+  const VkAccelerationStructureKHR old = handle_;
+  if (storage_.buffer) vkDestroyBuffer(device_.handle(), storage_.buffer, nullptr);
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size_;
+  info.usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+  vkkit::Check(vkCreateBuffer(device_.handle(), &info, nullptr, &storage_.buffer), "vkCreateBuffer");
+  vkkit::Check(vkBindBufferMemory(device_.handle(), storage_.buffer, storage_.memory, 0), "vkBindBufferMemory");
+  storage_buffer_ = storage_.buffer;
+  handle_ = VK_NULL_HANDLE;
+  Create();
+  return old;
+}
+
 BuildInfo Blas::Info(const Shape& shape, VkBuildAccelerationStructureModeKHR mode) const {
   BuildInfo b = MakeBuildInfo(shape, *inputs_);
   b.info.mode = mode;

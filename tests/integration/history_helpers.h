@@ -151,6 +151,11 @@ class Blas {
   // Destroys the VkBuffer the structure was created on (its own storage), not its memory nor the structure: the
   // handle stays alive on a buffer that is gone, address() stays backed by the same memory.
   void DestroyStorageBuffer();
+  // Deferred deletion, as engines do it: destroys the VkBuffer the structure was created on while its handle is
+  // kept (returned: the caller destroys it later), binds a new buffer to the same memory at the same offset and
+  // creates a new, unbuilt structure there, which gets the old one's address (on lavapipe a buffer's address is its
+  // memory's plus the offset: the caller checks). Only for a structure with storage of its own.
+  VkAccelerationStructureKHR Relocate();
   // The info Build/Update would record (dst, src and scratch set), for a call of several infos (RecordBuilds).
   BuildInfo Info(const Shape& shape, VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR) const;
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 #include "temp_report.h"
 #include "fixture.h"
@@ -48,6 +49,45 @@ TEST_CASE("a finding carries the VUID, its hash, the path, the spec text and nam
   CHECK(m.objects[1].objectType == VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR);
   CHECK(m.objects[1].objectHandle == reinterpret_cast<uint64_t>(build.blas.handle));
   CHECK(m.names[1] == "my BLAS");
+  build.Release(device);
+}
+
+TEST_CASE("a name ends with its object: a structure given a destroyed one's handle value is not shown under its "
+          "name",
+          "[integration][report]") {
+  Fixture f;
+  vkkit::Device& device = f.device();
+  vkkit::TriangleBuild build(device);
+  const VkAccelerationStructureKHR named = build.blas.handle;
+  device.SetName(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, reinterpret_cast<uint64_t>(named), "dead BLAS");
+  device.DestroyAccelerationStructureKHR(device.handle(), named, nullptr);
+  // New structures on the same storage until the driver hands the dead one's handle value out again (lavapipe
+  // reuses the freed object's memory at once).
+  VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+  info.buffer = build.blas.storage.buffer;
+  info.size = build.blas.storage.size;
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  std::vector<VkAccelerationStructureKHR> others;
+  build.blas.handle = VK_NULL_HANDLE;
+  for (int i = 0; i < 16 && build.blas.handle == VK_NULL_HANDLE; ++i) {
+    VkAccelerationStructureKHR created = VK_NULL_HANDLE;
+    vkkit::Check(device.CreateAccelerationStructureKHR(device.handle(), &info, nullptr, &created),
+                 "vkCreateAccelerationStructureKHR");
+    (created == named ? build.blas.handle : others.emplace_back()) = created;
+  }
+  for (VkAccelerationStructureKHR other : others) device.DestroyAccelerationStructureKHR(device.handle(), other, nullptr);
+  if (build.blas.handle == VK_NULL_HANDLE) {
+    build.Release(device);
+    SKIP("the driver did not hand the destroyed structure's handle value out again");
+  }
+  f.monitor().Expect(kVuid);
+  RecordMisalignedBuilds(device, build, 1);
+  std::vector<Message> messages = f.monitor().Take();
+  REQUIRE(messages.size() == 1);
+  REQUIRE(messages[0].objects.size() == 2);
+  CHECK(messages[0].objects[1].objectHandle == reinterpret_cast<uint64_t>(named));
+  CHECK(messages[0].names[1] == "");
+  CHECK(messages[0].text.find("dead BLAS") == std::string::npos);
   build.Release(device);
 }
 

@@ -533,7 +533,7 @@ TEST_CASE("history unit: command-buffer states follow allocation, secondaries, r
   CHECK_FALSE(map.Find(cbs[0])->Executable());
   map.Free(1, &cbs[0]);
   CHECK_FALSE(map.Find(cbs[0]));
-  map.DestroyPool(pool);
+  map.DestroyPool(pool, [](VkCommandBuffer) {});
   CHECK_FALSE(map.Find(cbs[1]));
   CHECK(map.size() == 0);
 }

@@ -131,6 +131,53 @@ using asval_test_common::TempReport;
 
 // U+FFFD REPLACEMENT CHARACTER in UTF-8: what each invalid byte of a name becomes in the report.
 constexpr const char* kReplacement = "\xEF\xBF\xBD";
+// A device handle for the names (the reporter only compares it).
+const VkDevice kDevice = reinterpret_cast<VkDevice>(uintptr_t{0x4000});
+
+TEST_CASE("object names end with their objects, are kept per type, and only for the types messages name",
+          "[report]") {
+  TempReport file;
+  ReportSettings settings;
+  settings.report_file = file.path;
+  Reporter reporter(settings);
+  const VkDevice other = reinterpret_cast<VkDevice>(uintptr_t{0x8000});
+  reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10, "dead structure");
+  reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_COMMAND_BUFFER, 0x10, "same value, another type");
+  reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_QUEUE, 0x20, "queue of the first device");
+  reporter.SetObjectName(other, VK_OBJECT_TYPE_QUEUE, 0x30, "queue of the other device");
+  reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_IMAGE, 0x40, "an image: never in a message, not kept");
+  // The structure is destroyed; a new one gets its handle value.
+  reporter.ForgetObjectName(ReportObject{VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10});
+  reporter.ForgetObjectNames(kDevice);  // the first device is destroyed: its queue's name goes, not the other's
+  reporter.Report(Severity::kError, k03710, Location("vkCmdBuildAccelerationStructuresKHR"),
+                  {ReportObject{VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10},
+                   ReportObject{VK_OBJECT_TYPE_QUEUE, 0x20}, ReportObject{VK_OBJECT_TYPE_QUEUE, 0x30},
+                   ReportObject{VK_OBJECT_TYPE_IMAGE, 0x40}},
+                  "m");
+  const std::vector<std::string> lines = file.Lines();
+  REQUIRE(lines.size() == 1);
+  const nlohmann::json objects = nlohmann::json::parse(lines[0])["objects"];
+  REQUIRE(objects.size() == 4);
+  CHECK_FALSE(objects[0].contains("name"));
+  CHECK_FALSE(objects[1].contains("name"));
+  CHECK(objects[2]["name"] == "queue of the other device");
+  CHECK_FALSE(objects[3].contains("name"));
+  // The command buffer of the same handle value kept its own name until it was freed.
+  TempReport second;
+  ReportSettings settings2;
+  settings2.report_file = second.path;
+  Reporter reporter2(settings2);
+  reporter2.SetObjectName(kDevice, VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10, "structure");
+  reporter2.SetObjectName(kDevice, VK_OBJECT_TYPE_COMMAND_BUFFER, 0x10, "command buffer");
+  reporter2.ForgetObjectName(ReportObject{VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10});
+  reporter2.Report(Severity::kError, k03710, Location("vkCmdBuildAccelerationStructuresKHR"),
+                   {ReportObject{VK_OBJECT_TYPE_COMMAND_BUFFER, 0x10},
+                    ReportObject{VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x10}},
+                   "m");
+  const nlohmann::json objects2 = nlohmann::json::parse(second.Lines().at(0))["objects"];
+  CHECK(objects2[0]["name"] == "command buffer");
+  CHECK_FALSE(objects2[1].contains("name"));
+}
 
 TEST_CASE("report_file lines parse as JSON whatever the object names hold", "[report]") {
   TempReport file;
@@ -139,12 +186,12 @@ TEST_CASE("report_file lines parse as JSON whatever the object names hold", "[re
     settings.report_file = file.path;
     Reporter reporter(settings);
     const std::string tricky = "say \"hi\" \\ tab\t newline\n bell\x07 caf\xC3\xA9";  // valid UTF-8
-    reporter.SetObjectName(0x1234, "\xff\xfe");                                 // not UTF-8 at all
-    reporter.SetObjectName(0x5678, tricky.c_str());
+    reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x1234, "\xff\xfe");  // not UTF-8 at all
+    reporter.SetObjectName(kDevice, VK_OBJECT_TYPE_QUEUE, 0x5678, tricky.c_str());
     reporter.Report(Severity::kError, k03710, Location("vkCmdBuildAccelerationStructuresKHR").Field("pInfos", 0).Field("scratchData"),
                     {ReportObject{VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, 0x1234},
                      ReportObject{VK_OBJECT_TYPE_COMMAND_BUFFER, 0},
-                     ReportObject{VK_OBJECT_TYPE_BUFFER, 0x5678}},
+                     ReportObject{VK_OBJECT_TYPE_QUEUE, 0x5678}},
                     "a \"quoted\" message\n");
     reporter.LayerNotice(Severity::kWarning, "a notice with \xff in it");
 
@@ -168,7 +215,7 @@ TEST_CASE("report_file lines parse as JSON whatever the object names hold", "[re
     CHECK(objects[0]["type"] == "VkAccelerationStructureKHR");
     CHECK(objects[0]["handle"] == "0x1234");
     CHECK(objects[0]["name"] == std::string(kReplacement) + kReplacement);
-    CHECK(objects[1]["type"] == "VkBuffer");
+    CHECK(objects[1]["type"] == "VkQueue");
     CHECK(objects[1]["handle"] == "0x5678");
     CHECK(objects[1]["name"] == tricky);
     // Keys in the order the report has always had: readers that print lines raw see the same thing.
