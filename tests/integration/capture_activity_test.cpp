@@ -663,6 +663,46 @@ TEST_CASE("capture: a secondary executed twice by one primary: each execution's 
   }
 }
 
+// The limit (capture.md, "Executed more than once"): a SIMULTANEOUS_USE primary listed twice in one batch writes its
+// captures twice before the host reads them, and nothing between its executions is the layer's. Its second update
+// would make triangle 1 active (the batch rewrites its X between them); both updates are skipped and counted, never
+// judged on bytes the second execution overwrote.
+TEST_CASE("capture: a primary listed twice in one batch: its updates are skipped and counted, never guessed",
+          "[integration][capture]") {
+  asval_test_common::TempReport report;
+  {
+    HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"}});
+    {
+      Rig rig(f);
+      std::vector<uint32_t> vertices = Vertices();
+      vertices[3 * 3] = kNan;  // triangle 1 inactive in the build
+      BuildTriangles(rig, vertices);
+      VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+      alloc.commandPool = rig.commands().pool();
+      alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+      alloc.commandBufferCount = 1;
+      VkCommandBuffer refit = VK_NULL_HANDLE;
+      REQUIRE(vkAllocateCommandBuffers(rig.device().handle(), &alloc, &refit) == VK_SUCCESS);
+      VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      begin.flags = VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT;
+      REQUIRE(vkBeginCommandBuffer(refit, &begin) == VK_SUCCESS);
+      rig.commands().Barrier(refit);
+      rig.Update(refit, Triangles());
+      REQUIRE(vkEndCommandBuffer(refit) == VK_SUCCESS);
+      const VkCommandBuffer rewrite = rig.Record([&](VkCommandBuffer cb) {
+        rig.AfterBuild(cb);
+        rig.Write(cb, Component(3, 0), {Bits(0.0f)});
+      });
+      CHECK(rig.commands().Submit({refit, rewrite, refit}) == VK_SUCCESS);  // waits for the queue
+      CHECK(f.monitor().Verify() == "");
+    }
+    f.Close();
+  }
+  const Judged judged = ReadJudged(report);
+  CHECK(judged.updates == 0);
+  CHECK(judged.skipped_unknown);
+}
+
 TEST_CASE("capture: with capture=off, an update that makes a triangle inactive is not reported",
           "[integration][capture]") {
   HistoryFixture f(nullptr, {{"capture", "off"}});
