@@ -38,7 +38,10 @@ bool CapturePool::Create(VkDeviceSize bytes, CaptureSlab* slab) {
   if (memory_type_ == UINT32_MAX || !next_.CreateBuffer || !next_.AllocateMemory || !next_.MapMemory) return false;
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = bytes;
-  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | (reducer_ ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
+  // TRANSFER_SRC: a secondary executed twice by one primary has its first execution's captures copied out of
+  // the slab before the second writes it again (capture_saves.h).
+  info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+               (reducer_ ? VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT : 0);
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   CaptureSlab s;
   s.size = bytes;

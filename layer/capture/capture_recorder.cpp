@@ -46,8 +46,9 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
   }
   // The copies (and the dispatch's writes) are visible to the host once the submission completes; later
   // commands (writes of the inputs included) wait for the reads. Later writes into the same capture bytes (a
-  // secondary command buffer executed twice, whose capture is then unknown anyway) are ordered after these writes
-  // too: without them here they would race (a write-after-write hazard that synchronization validation reports).
+  // command buffer executed twice: a secondary's next execution after the layer saved these bytes, capture_saves.h,
+  // or a primary listed twice, whose captures are then unknown) are ordered after these writes too: without them
+  // here they would race (a write-after-write hazard that synchronization validation reports).
   VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | (reduces ? VK_ACCESS_SHADER_WRITE_BIT : 0);
   after.dstAccessMask =

@@ -1,6 +1,7 @@
 // Command pools and command buffers: which pool each command buffer came from, its level, whether it is
 // protected (commandBuffer-09547), and the acceleration-structure operations each recording holds
 // (CommandBufferMap, layer/state/command_buffers.h).
+#include "capture_saves.h"
 #include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
@@ -80,8 +81,17 @@ VKAPI_ATTR VkResult VKAPI_CALL ResetCommandBuffer(VkCommandBuffer commandBuffer,
 VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uint32_t commandBufferCount,
                                               const VkCommandBuffer* pCommandBuffers) {
   DeviceData* data = GetDeviceData(commandBuffer);
-  data->dispatch.CmdExecuteCommands(commandBuffer, commandBufferCount, pCommandBuffers);
-  RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);
+  if (!data->capture_pool || !pCommandBuffers) {
+    data->dispatch.CmdExecuteCommands(commandBuffer, commandBufferCount, pCommandBuffers);
+    RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);
+  } else {
+    // Bends the order: a secondary whose captures this recording already reads (executed twice) has what the
+    // executions before it wrote saved first, so the app's array goes down in parts, around the layer's copies, as
+    // the recorder finds them (capture_saves.h); the rest goes down after.
+    ExecuteCommandsSaver saver(data->dispatch, commandBuffer, pCommandBuffers);
+    RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers, &saver);
+    saver.PassDown(commandBufferCount);
+  }
   // Protect mode: a secondary holding a withheld command marks the primary (a single load until one is marked).
   data->state.command_buffers.InheritWithheld(commandBuffer, commandBufferCount, pCommandBuffers);
 }

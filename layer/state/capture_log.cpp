@@ -9,22 +9,42 @@ constexpr VkDeviceSize kAlignment = 16;
 }  // namespace
 
 bool CaptureLog::Reserve(VkDeviceSize size, CapturedBytes* where) {
-  const VkDeviceSize offset = (used_in_last_slab_ + kAlignment - 1) & ~(kAlignment - 1);
+  const VkDeviceSize used = used_.empty() ? 0 : used_.back();
+  const VkDeviceSize offset = (used + kAlignment - 1) & ~(kAlignment - 1);
   if (slabs.empty() || offset > slabs.back().size || size > slabs.back().size - offset) {
     // Room first: a slab taken and then not kept would be lost to the pool until the device goes.
     slabs.reserve(slabs.size() + 1);
+    used_.reserve(slabs.size() + 1);
     CaptureSlab slab;
     if (!owner_->Take(size, &slab)) return false;
     slabs.push_back(slab);
-    used_in_last_slab_ = 0;
+    used_.push_back(0);
     return Reserve(size, where);
   }
   where->slab = static_cast<uint32_t>(slabs.size() - 1);
   where->offset = offset;
   where->size = size;
   where->present = true;
-  used_in_last_slab_ = offset + size;
+  used_.back() = offset + size;
   return true;
+}
+
+std::shared_ptr<CaptureLog> CaptureLog::EmptyCopy() const {
+  auto copy = std::make_shared<CaptureLog>(owner_);
+  copy->bytes_captured = bytes_captured;
+  copy->infos = infos;
+  copy->geometries = geometries;
+  copy->max_primitive_counts = max_primitive_counts;
+  copy->destinations = destinations;
+  copy->blobs = blobs;
+  copy->slabs.reserve(slabs.size());
+  copy->used_ = used_;
+  for (uint32_t k = 0; k < slabs.size(); ++k) {
+    CaptureSlab slab;
+    if (!owner_->Take(std::max<VkDeviceSize>(UsedBytes(k), 1), &slab)) return nullptr;  // gives back those taken
+    copy->slabs.push_back(slab);
+  }
+  return copy;
 }
 
 uint32_t CaptureLog::AddInfo(CapturedInfo entry, const CapturedGeometry* info_geometries, const uint32_t* max_counts,

@@ -51,7 +51,7 @@ struct CaptureCounters {
 
 // One block of layer-owned memory that the device copies build inputs into and the host reads.
 struct CaptureSlab {
-  VkBuffer buffer = VK_NULL_HANDLE;  // TRANSFER_DST (and SHADER_DEVICE_ADDRESS when the capture reduces)
+  VkBuffer buffer = VK_NULL_HANDLE;  // TRANSFER_DST, TRANSFER_SRC (and SHADER_DEVICE_ADDRESS when the capture reduces)
   VkDeviceMemory memory = VK_NULL_HANDLE;
   uint8_t* mapped = nullptr;  // host-visible, coherent, mapped for the slab's lifetime
   VkDeviceSize size = 0;
@@ -228,6 +228,15 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
     return static_cast<uint32_t>(blobs.size());
   }
 
+  // ---- a secondary executed again by one primary (layer/capture/capture_saves.h) ----
+  // How many bytes of slabs[slab] the captures use (from its start): what a save copies.
+  VkDeviceSize UsedBytes(uint32_t slab) const { return slab < used_.size() ? used_[slab] : 0; }
+  // A log with the same captures (infos, geometries, destinations, blobs) in slabs of its own, each as large as
+  // this log's use of the slab of the same index: what the device copies this log's bytes into, so that they are
+  // read from there once an execution of the recording wrote them and before the next writes them again. Null
+  // when the pool gives no slab; throws std::bad_alloc.
+  std::shared_ptr<CaptureLog> EmptyCopy() const;
+
   // ---- under the capture processing lock (CaptureTracker) ----
   // A submission that reads this recording's captures is about to be made / was processed or not made. A second
   // one while the first is pending (a SIMULTANEOUS_USE command buffer) makes the device write the same bytes
@@ -262,7 +271,7 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
 
  private:
   std::shared_ptr<CaptureSlabOwner> owner_;
-  VkDeviceSize used_in_last_slab_ = 0;
+  std::vector<VkDeviceSize> used_;  // per slab, the bytes its captures use (from its start)
   uint32_t pending_submissions_ = 0;
   bool overlapped_ = false;
 };

@@ -209,6 +209,13 @@ class OpBatch {
   void Append(const AsOp& op) { ops_.push_back(op); }
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.
   void AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary);
+  // The operations appended so far that read their captures from `from` read them from `to` instead (the
+  // earlier executions of a secondary executed again: layer/capture/capture_saves.h).
+  void MoveCaptures(const CaptureLog* from, CaptureLog* to) {
+    for (AsOp& op : ops_) {
+      if (op.capture_log == from) op.capture_log = to;
+    }
+  }
 
  private:
   // The geometries of one info from pGeometries, appended at once (capacity reserved by the caller).

@@ -161,8 +161,9 @@ IndirectRangeCheck IndirectCheck(const HistoryStore& store, const AsOp& op, Capt
 }
 
 // A captured build's activity, filled when its submission completes; an update's comparison with its source's.
-// The same capture read twice by one submission (a secondary executed twice, a command buffer submitted twice in
-// one call) holds the bytes of the last execution only: both are unknown.
+// The same capture read twice by one submission (a command buffer submitted twice in one call, a secondary executed
+// by two of its primaries; a secondary executed twice by one primary reads a saved copy the first time, unless the
+// copy could not be made: capture_saves.h) holds the bytes of the last execution only: both are unknown.
 std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const HistoryStore& store, const AsOp& op,
                                                 SubmissionCaptures& captures) {
   CaptureLog* log = op.capture_log;
@@ -318,8 +319,8 @@ void ApplyCopy(const DeviceState& state, HistoryStore& store, const AsOp& op, Tr
 }
 
 // Whether one submission already reads capture (log, blob) of a serialization or deserialization: the device then
-// writes its bytes twice before the layer reads them (a secondary executed twice, a command buffer submitted twice
-// in one call), so that both readers are unknown. Submissions serialize rarely: a scan.
+// writes its bytes twice before the layer reads them (a command buffer submitted twice in one call, a secondary
+// executed by two of its primaries), so that both readers are unknown. Submissions serialize rarely: a scan.
 bool ClaimBlob(SubmissionCaptures& captures, CaptureLog* log, uint32_t blob) {
   bool first = true;
   for (SerializeCapture& s : captures.serializes) {

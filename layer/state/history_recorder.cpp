@@ -1,5 +1,6 @@
 #include "history_recorder.h"
 
+#include <algorithm>
 #include <cstring>
 #include <new>
 
@@ -213,11 +214,51 @@ void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipelin
   }
 }
 
+namespace {
+
+// Before secondary `index` (whose recording is `ops`) executes again in `recording`: each of its capture logs that
+// the recording already reads is copied, by the device, into a log of its own, which the operations appended so
+// far read from then on. A log that cannot be copied stays shared: the executions' captures are then read twice by
+// one submission, unknown and counted there (history_apply.cpp), never guessed.
+void SaveExecutedCaptures(DeviceState& state, CommandBufferState& recording, const RecordedOps& ops, uint32_t index,
+                          CaptureSaver& saver) {
+  const auto& held = recording.executed_capture_logs;
+  bool passed_down = false;
+  for (std::size_t k = 0; k < ops.capture_logs.size(); ++k) {
+    const std::shared_ptr<CaptureLog>& log = ops.capture_logs[k];
+    if (std::find(held.begin(), held.end(), log) == held.end()) continue;  // its first execution here
+    if (std::find(ops.capture_logs.begin(), ops.capture_logs.begin() + k, log) != ops.capture_logs.begin() + k) {
+      continue;  // listed twice by the secondary (a secondary it executes twice): saved once
+    }
+    if (!passed_down) {  // the executions so far are recorded before the copies
+      saver.PassDown(index);
+      passed_down = true;
+    }
+    std::shared_ptr<CaptureLog> copy;
+    try {
+      copy = log->EmptyCopy();
+      if (copy) recording.executed_capture_logs.push_back(copy);  // held before the device may write it
+    } catch (const std::bad_alloc&) {
+      state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    if (!copy) {
+      state.failures().capture_memory_failures.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    if (saver.RecordCopy(*log, *copy)) recording.recording.MoveCaptures(log.get(), copy.get());
+  }
+}
+
+}  // namespace
+
 void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
-                           const VkCommandBuffer* secondaries) {
+                           const VkCommandBuffer* secondaries, CaptureSaver* saver) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, primary);
   if (!recording || !secondaries) return;
   recording->compute_pipeline = VK_NULL_HANDLE;  // the primary's bound state is undefined after the secondaries
+  // A protected primary may not write the layer's unprotected memory: its secondaries' captures stay shared.
+  if (recording->is_protected) saver = nullptr;
   for (uint32_t i = 0; i < count; ++i) {
     Guarded(state, *recording, [&] { recording->secondaries.push_back(secondaries[i]); });
     const std::shared_ptr<CommandBufferState> secondary = state.command_buffers.Find(secondaries[i]);
@@ -229,6 +270,7 @@ void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t
     const std::shared_ptr<const RecordedOps> ops = secondary->Executable();
     if (!ops) continue;
     if (ops->lost) recording->recording_lost = true;
+    if (saver && !ops->capture_logs.empty()) SaveExecutedCaptures(state, *recording, *ops, i, *saver);
     Guarded(state, *recording, [&] {
       recording->recording.AppendExecuted(ops->batch, primary);
       recording->executed_capture_logs.insert(recording->executed_capture_logs.end(), ops->capture_logs.begin(),

@@ -42,9 +42,28 @@ void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t c
 // vkCmdBindPipeline with VK_PIPELINE_BIND_POINT_COMPUTE, where the capture reduces on the device: the pipeline the
 // layer binds again after its dispatch (CommandBufferState::compute_pipeline).
 void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipeline pipeline);
-// vkCmdExecuteCommands: the secondaries' completed recordings join the primary's, in order.
+// A secondary executed again by one recording of a primary (a SIMULTANEOUS_USE secondary executed twice, or a
+// secondary executed by two secondaries that one primary executes): the device writes its capture bytes again
+// before the host reads them. So before that execution, what the executions so far wrote is copied into a log of
+// their own (CaptureLog::EmptyCopy), and their operations read it there. The copies are recorded into the primary
+// by layer/capture (capture_saves.h), which also passes the app's secondaries down in parts around them.
+class CaptureSaver {
+ public:
+  // The app's secondaries before index `next` not passed down yet go down (vkCmdExecuteCommands of that part).
+  virtual void PassDown(uint32_t next) = 0;
+  // Records into the primary the copy of `from`'s bytes, as the executions so far left them, into `to` (from's
+  // EmptyCopy, held by the primary's recording before this is called). False when nothing was recorded.
+  virtual bool RecordCopy(const CaptureLog& from, const CaptureLog& to) = 0;
+
+ protected:
+  ~CaptureSaver() = default;
+};
+
+// vkCmdExecuteCommands: the secondaries' completed recordings join the primary's, in order. With a saver (the
+// device captures), a secondary whose captures the primary's recording already reads has them saved first
+// (CaptureSaver); the caller then passes down what the saver has not (saver->PassDown(count)).
 void RecordExecuteCommands(DeviceState& state, VkCommandBuffer primary, uint32_t count,
-                           const VkCommandBuffer* secondaries);
+                           const VkCommandBuffer* secondaries, CaptureSaver* saver = nullptr);
 
 // ---- host commands: their operations (pure: built before the checks run) ----
 // `capture`, `captured`: the inputs captured when the build was called (host_capture.h; null: none): each

@@ -548,7 +548,7 @@ TEST_CASE("capture valid twin: updates that keep each primitive's activity and t
     rig.Run(both, Wait::kFence);
   }
   SECTION("a secondary command buffer with a refit, executed twice by one primary") {
-    // Its capture is written twice before it is read: unknown, and skipped (never a guess).
+    // Each execution's capture is read from its own bytes (the first's saved before the second writes the slab).
     BuildTriangles(rig);
     VkCommandBuffer secondary = rig.commands().BeginSecondary(VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT);
     rig.commands().Barrier(secondary);
@@ -562,7 +562,6 @@ TEST_CASE("capture valid twin: updates that keep each primitive's activity and t
       procs.CmdExecuteCommands(cb, 1, &secondary);
     }));
     CHECK(f.monitor().Verify() == "");
-    BuildTriangles(rig);  // a known activity again, for the probe
   }
   SECTION("an update command buffer submitted again after the first submission completed") {
     BuildTriangles(rig);
@@ -576,6 +575,132 @@ TEST_CASE("capture valid twin: updates that keep each primitive's activity and t
   }
   CHECK(f.monitor().Verify() == "");
   CHECK(Probe(rig, f.monitor(), shape) == "");
+}
+
+// How many updates the layer judged on their captured activity, and whether any check was skipped for unknown state,
+// as ASVAL-History-Summary (at vkDestroyDevice, in the JSON report) says.
+struct Judged {
+  uint64_t updates = 0;
+  bool skipped_unknown = false;
+};
+Judged ReadJudged(const asval_test_common::TempReport& report) {
+  Judged j;
+  for (const std::string& line : report.Lines()) {
+    const std::string judged = " updates judged on their captured activity";
+    const std::size_t at = line.find(judged);
+    if (at != std::string::npos) {
+      const std::size_t start = line.rfind(", ", at) + 2;
+      j.updates = std::stoull(line.substr(start, at - start));
+    }
+    j.skipped_unknown |= line.find("checks were skipped because the state they need was unknown") != std::string::npos;
+  }
+  return j;
+}
+
+// Issue 25, item 5: a SIMULTANEOUS_USE secondary holding an update, executed twice by one primary, with the update's
+// input rewritten on the device between the two executions. Each execution's update is judged on the bytes it read:
+// the second one's against the first one's (the source's last executed build). Before, both shared one capture
+// slot and were skipped as unknown. Triangle 1 is inactive in the build (a NaN X); between the executions its X is
+// written 0 (active: pInfos-03663 on the second execution) or another NaN (still inactive: the valid twin, whose
+// two updates must be judged, not skipped). Between the executions: an update of the primary's own (vkCmdFillBuffer
+// in the primary), or a third secondary doing the fill, with all three in one vkCmdExecuteCommands.
+TEST_CASE("capture: a secondary executed twice by one primary: each execution's update is judged on its own bytes",
+          "[integration][capture]") {
+  for (const bool one_call : {false, true}) {
+    for (const bool activates : {true, false}) {
+      DYNAMIC_SECTION((one_call ? "one vkCmdExecuteCommands of three" : "two vkCmdExecuteCommands")
+                      << (activates ? ": triangle 1 made active (pInfos-03663)" : ": valid twin")) {
+        asval_test_common::TempReport report;
+        {
+          HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"}});
+          {
+            Rig rig(f);
+            std::vector<uint32_t> vertices = Vertices();
+            vertices[3 * 3] = kNan;  // triangle 1 inactive in the build
+            BuildTriangles(rig, vertices);
+            VkCommandBuffer refit = rig.commands().BeginSecondary(VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT);
+            rig.commands().Barrier(refit);  // after the build, or the first execution's update
+            rig.Update(refit, Triangles());
+            rig.commands().End(refit);
+            // Triangle 1's first X, rewritten once the first execution's update has read it.
+            const auto rewrite = [&](VkCommandBuffer cb) {
+              rig.AfterBuild(cb);
+              if (activates) {
+                rig.Write(cb, Component(3, 0), {Bits(0.0f)});
+              } else {
+                rig.Fill(cb, Component(3, 0), kOtherNan);
+              }
+            };
+            const Procs procs(rig.device());
+            if (one_call) {
+              VkCommandBuffer write = rig.commands().BeginSecondary();
+              rewrite(write);
+              rig.commands().End(write);
+              const VkCommandBuffer three[] = {refit, write, refit};
+              rig.Run(rig.Record([&](VkCommandBuffer cb) { procs.CmdExecuteCommands(cb, 3, three); }), Wait::kFence);
+            } else {
+              rig.Run(rig.Record([&](VkCommandBuffer cb) {
+                procs.CmdExecuteCommands(cb, 1, &refit);
+                rewrite(cb);
+                procs.CmdExecuteCommands(cb, 1, &refit);
+              }),
+                      Wait::kFence);
+            }
+            if (activates) {
+              CHECK(OnlyFinding(f.monitor(), kBecameActive, "geometry 0: 1 primitive(s) inactive in the source are "
+                                                            "active in the update: primitive 1") == "");
+            } else {
+              CHECK(f.monitor().Verify() == "");
+            }
+          }
+          f.Close();
+        }
+        const Judged judged = ReadJudged(report);
+        CHECK(judged.updates == 2);  // both executions' updates, none skipped
+        CHECK_FALSE(judged.skipped_unknown);
+      }
+    }
+  }
+}
+
+// The limit (capture.md, "Executed more than once"): a SIMULTANEOUS_USE primary listed twice in one batch writes its
+// captures twice before the host reads them, and nothing between its executions is the layer's. Its second update
+// would make triangle 1 active (the batch rewrites its X between them); both updates are skipped and counted, never
+// judged on bytes the second execution overwrote.
+TEST_CASE("capture: a primary listed twice in one batch: its updates are skipped and counted, never guessed",
+          "[integration][capture]") {
+  asval_test_common::TempReport report;
+  {
+    HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"}});
+    {
+      Rig rig(f);
+      std::vector<uint32_t> vertices = Vertices();
+      vertices[3 * 3] = kNan;  // triangle 1 inactive in the build
+      BuildTriangles(rig, vertices);
+      VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+      alloc.commandPool = rig.commands().pool();
+      alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+      alloc.commandBufferCount = 1;
+      VkCommandBuffer refit = VK_NULL_HANDLE;
+      REQUIRE(vkAllocateCommandBuffers(rig.device().handle(), &alloc, &refit) == VK_SUCCESS);
+      VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      begin.flags = VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT;
+      REQUIRE(vkBeginCommandBuffer(refit, &begin) == VK_SUCCESS);
+      rig.commands().Barrier(refit);
+      rig.Update(refit, Triangles());
+      REQUIRE(vkEndCommandBuffer(refit) == VK_SUCCESS);
+      const VkCommandBuffer rewrite = rig.Record([&](VkCommandBuffer cb) {
+        rig.AfterBuild(cb);
+        rig.Write(cb, Component(3, 0), {Bits(0.0f)});
+      });
+      CHECK(rig.commands().Submit({refit, rewrite, refit}) == VK_SUCCESS);  // waits for the queue
+      CHECK(f.monitor().Verify() == "");
+    }
+    f.Close();
+  }
+  const Judged judged = ReadJudged(report);
+  CHECK(judged.updates == 0);
+  CHECK(judged.skipped_unknown);
 }
 
 TEST_CASE("capture: with capture=off, an update that makes a triangle inactive is not reported",
