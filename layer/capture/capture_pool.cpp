@@ -25,11 +25,13 @@ uint32_t PickMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t
 }  // namespace
 
 CapturePool::CapturePool(VkDevice device, const DeviceDispatchTable& next,
-                         const VkPhysicalDeviceMemoryProperties& memory, bool reduce)
+                         const VkPhysicalDeviceMemoryProperties& memory, bool reduce, bool gather)
     : device_(device), next_(next) {
   memory_type_ = PickMemoryType(memory, ~0u);
-  if (reduce) reducer_ = CaptureReducer::Create(device, next, memory_type_);  // null: the capture copies
-  reduces_ = reducer_ != nullptr;
+  // Null: the capture copies, and gathers nothing.
+  if (reduce || gather) reducer_ = CaptureReducer::Create(device, next, memory_type_);
+  reduces_ = reduce && reducer_ != nullptr;
+  gathers_ = gather && reducer_ != nullptr;
 }
 
 CapturePool::~CapturePool() { Shutdown(); }

@@ -21,10 +21,11 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   // Slabs are at least this large (a slab serves many captures of one recording).
   static constexpr VkDeviceSize kSlabBytes = VkDeviceSize{4} << 20;
 
-  // `reduce`: the capture reduces on the device (capture_method, CaptureReduces) where the device lets the
-  // reducer be made; every slab then gets a device address and a place in the reducer's slab table.
+  // `reduce`: the capture reduces on the device (capture_method, CaptureReduces); `gather`: the layer's dispatch
+  // gathers the records of arrays of instance pointers (CaptureGathers). Either makes the reducer where the device
+  // lets it be made; every slab then gets a device address and a place in the reducer's slab table.
   CapturePool(VkDevice device, const DeviceDispatchTable& next, const VkPhysicalDeviceMemoryProperties& memory,
-              bool reduce = false);
+              bool reduce = false, bool gather = false);
   ~CapturePool() override;
 
   // A slab of at least `bytes`; nullopt when the device cannot give one (no host-visible coherent memory type,
@@ -37,6 +38,10 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   void AddFootprint(CaptureFootprint* out);
   // The capture reduces on the device (CaptureLog::TableIndexOf says where a slab is in the table).
   bool reduces() const { return reduces_; }
+  // The layer's dispatch gathers arrays of instance pointers' records (also where the capture copies).
+  bool gathers() const { return gathers_; }
+  // The layer may bind its pipeline in the app's command buffers (and binds the app's compute pipeline again).
+  bool dispatches() const { return reduces_ || gathers_; }
   // The reducing pipeline (compiled at the first call; null when it could not be: the captures are then copied).
   VkPipeline ReducePipeline() { return reducer_ ? reducer_->Pipeline() : VK_NULL_HANDLE; }
 
@@ -49,6 +54,7 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   uint32_t memory_type_ = UINT32_MAX;  // HOST_VISIBLE | HOST_COHERENT, HOST_CACHED preferred (the host reads)
   std::unique_ptr<CaptureReducer> reducer_;  // until Shutdown
   bool reduces_ = false;                     // set at construction
+  bool gathers_ = false;                     // set at construction
   std::mutex mutex_;
   std::vector<CaptureSlab> free_;
   std::vector<CaptureSlab> all_;  // every live slab, for Shutdown

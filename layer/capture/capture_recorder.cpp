@@ -24,6 +24,10 @@ struct Copy {
   VkBufferCopy region;
 };
 
+// How the capture reads a geometry: copies of its ranges, the layer's dispatch reducing them in place, or (an array
+// of instance pointers) the dispatch gathering the pointers and the records they name.
+enum Stage : uint8_t { kCopied = 0, kReduced = 1, kGathered = 2 };
+
 // The captures of one command, between two barriers: copies, then the reducing dispatch (after which the app's
 // compute pipeline, `app_pipeline`, is bound again).
 void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies,
@@ -216,14 +220,15 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
   thread_local std::vector<Copy> copies;
   thread_local std::vector<CaptureSource> sources;
   thread_local std::vector<uint32_t> first_source;     // per geometry, and one past the last
-  thread_local std::vector<uint8_t> reduced;           // per geometry: read in place by the command's dispatch
+  thread_local std::vector<uint8_t> reduced;           // per geometry: how it is captured (Stage)
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   thread_local std::vector<CommandDestination> destinations;
   copies.clear();
   CommandCounts counts;
-  // capture_method reduce: one dispatch for the command, its jobs in one block, taken at the first capture.
+  // The layer's dispatch (capture_method reduce, or gathering arrays of instance pointers' records): one for the
+  // command, its jobs in one block, taken at the first capture that needs it.
   JobBlock block;
-  bool block_tried = !ctx.pool.reduces();
+  bool block_tried = !ctx.pool.dispatches();
   bool destinations_logged = false;
   uint32_t first_destination = 0;
   for (uint32_t i = 0; i < info_count; ++i) {
@@ -238,19 +243,6 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
       continue;
     }
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
-    if (!block_tried) {  // room for a job per geometry of the infos captured from here on
-      uint32_t jobs = 0;
-      for (uint32_t k = i; k < info_count; ++k) {
-        if (NeedsCapture(ctx.mode, infos[k])) jobs += std::min(infos[k].geometryCount, kReduceMaxJobsPerDispatch + 1);
-        jobs = std::min(jobs, kReduceMaxJobsPerDispatch + 1);
-      }
-      const VkPipeline pipeline = ctx.pool.ReducePipeline();
-      if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
-        ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
-      }
-      block.Acquire(log, jobs, pipeline);
-      block_tried = true;
-    }
     CapturedInfo entry;
     entry.geometry_count = info.geometryCount;
     entry.element = i;
@@ -271,12 +263,35 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
       entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources);
       first_source.push_back(static_cast<uint32_t>(sources.size()));
     }
+    if (!block_tried) {
+      // Where the capture copies, only an array of instance pointers needs the dispatch (its records' stage).
+      bool wanted = ctx.pool.reduces();
+      for (std::size_t j = 0; j + 1 < first_source.size() && !wanted; ++j) wanted = Gatherable(planned[j]);
+      if (wanted) {  // room for a job per geometry of the infos captured from here on
+        uint32_t jobs = 0;
+        for (uint32_t k = i; k < info_count; ++k) {
+          if (NeedsCapture(ctx.mode, infos[k])) jobs += std::min(infos[k].geometryCount, kReduceMaxJobsPerDispatch + 1);
+          jobs = std::min(jobs, kReduceMaxJobsPerDispatch + 1);
+        }
+        const VkPipeline pipeline = ctx.pool.ReducePipeline();
+        if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
+          ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
+        }
+        block.Acquire(log, jobs, pipeline);
+        block_tried = true;
+      }
+    }
     // What the info costs: each geometry's bytes, or what the dispatch writes for it and its job.
-    reduced.assign(first_source.size() - 1, 0);
+    reduced.assign(first_source.size() - 1, kCopied);
     VkDeviceSize total = 0;
     for (std::size_t j = 0; j < reduced.size(); ++j) {
-      reduced[j] = block.ok && Reducible(planned[j]);
-      if (reduced[j]) {
+      if (block.ok && ctx.pool.gathers() && Gatherable(planned[j]) && first_source[j + 1] == first_source[j] + 1) {
+        reduced[j] = kGathered;
+        total = SaturatingAddBytes(total, GatheredCost(planned[j]));
+        continue;
+      }
+      reduced[j] = block.ok && ctx.pool.reduces() && Reducible(planned[j]) ? kReduced : kCopied;
+      if (reduced[j] == kReduced) {
         const ReducedSources of = SourcesOf(planned[j], sources.data() + first_source[j],
                                             sources.data() + first_source[j + 1]);
         total = SaturatingAddBytes(total, ReducedCost(planned[j], of));
@@ -293,7 +308,11 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     const std::size_t first_copy = copies.size();
     const uint32_t first_job = block.dispatch.jobs;
     for (std::size_t j = 0; j < reduced.size() && entry.complete; ++j) {
-      if (reduced[j]) {
+      if (reduced[j] == kGathered) {
+        entry.complete = GatherInstancePointers(ctx.state, log, planned[j], sources[first_source[j]], block);
+        continue;
+      }
+      if (reduced[j] == kReduced) {
         entry.complete = ReduceGeometry(
             ctx.state, log, planned[j],
             SourcesOf(planned[j], sources.data() + first_source[j], sources.data() + first_source[j + 1]), block);

@@ -9,9 +9,10 @@
 //
 // Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
 // update's source: their activity record), updates, and every top-level build (its instance references); with
-// `all`, every bottom-level build too. Arrays of instance pointers: the pointers only (their alignment is checked;
-// the records they point to cannot be located when the copies are recorded). Not captured yet (their rules
-// skipped and counted): motion instances, vertex formats the builder does not decode.
+// `all`, every bottom-level build too. Arrays of instance pointers: the pointers, then the records they point to,
+// gathered by the layer's dispatch where the pool gathers (CaptureGathers; elsewhere the pointers only, the records
+// unknown). Not captured yet (their rules skipped and counted): motion instances, vertex formats the builder does
+// not decode.
 #include <vulkan/vulkan.h>
 
 #include <atomic>

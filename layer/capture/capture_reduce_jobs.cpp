@@ -35,6 +35,9 @@ ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDevic
   } else if (g.type == VK_GEOMETRY_TYPE_AABBS_KHR) {
     job.kind = ReduceJob::kAabbs;
     job.stride = static_cast<uint32_t>(g.aabb_stride);
+  } else if (g.array_of_pointers) {
+    job.kind = ReduceJob::kGatherInstances;
+    job.stride = sizeof(VkDeviceAddress);
   } else {
     job.kind = ReduceJob::kInstances;
     job.stride = sizeof(VkAccelerationStructureInstanceKHR);
@@ -80,6 +83,29 @@ void JobBlock::Add(const ReduceJob& job) {
   ++dispatch.jobs;
   const VkDeviceSize groups = (VkDeviceSize{job.count} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup;
   dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
+}
+
+bool Gatherable(const CapturedGeometry& g) {
+  const uint32_t n = g.range.primitiveCount;
+  return g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR && g.array_of_pointers && n != 0 && n <= UINT32_MAX / 72;
+}
+
+bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
+                            const CaptureSource& pointers, JobBlock& block) {
+  if (!CaptureSourceBuffer(state, pointers.address, pointers.size, CaptureRead::kInPlace) ||
+      block.dispatch.jobs >= block.capacity) {
+    return false;
+  }
+  CapturedBytes out;
+  if (!log.Reserve(GatheredBytes(g.range.primitiveCount), &out)) {
+    state.capture_counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);  // no slab
+    return false;
+  }
+  const VkDeviceSize pointer_bytes = 8 * VkDeviceSize{g.range.primitiveCount};
+  g.pointers = CapturedBytes{out.slab, out.offset, pointer_bytes, true};
+  g.data = CapturedBytes{out.slab, out.offset + pointer_bytes, out.size - pointer_bytes, true};
+  block.Add(MakeReduceJob(g, pointers.address, 0, 0, log.AddressOf(out)));
+  return true;
 }
 
 ReducedSources SourcesOf(const CapturedGeometry& g, const CaptureSource* first, const CaptureSource* last) {

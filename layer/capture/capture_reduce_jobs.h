@@ -40,6 +40,19 @@ struct JobBlock {
 // instances given as an array of records, with strides the shader's 32-bit arithmetic holds.
 bool Reducible(const CapturedGeometry& g);
 
+// The second stage of an array of instance pointers' capture (where the pool gathers, CaptureGathers): the
+// command's dispatch reads the pointers where the build reads them and copies them, and the 64-byte record each
+// followed one names (FollowedInstancePointer), into the log (CapturedGeometry::pointers, then ::data: GatheredBytes).
+// Gatherable: g is such an array, and the shader's 32-bit arithmetic holds its bytes; GatheredCost: what it costs
+// the recording's budget (the bytes and the job). GatherInstancePointers: false when the pointers cannot be read in
+// place (no bound buffer holds them) or there is no room: the info is then not captured.
+bool Gatherable(const CapturedGeometry& g);
+inline VkDeviceSize GatheredCost(const CapturedGeometry& g) {
+  return GatheredBytes(g.range.primitiveCount) + sizeof(ReduceJob);
+}
+bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
+                            const CaptureSource& pointers, JobBlock& block);
+
 // Geometry g's sources among its planned ones [first, last): its data, and for triangles its indices and its
 // transform (each null when the plan has none).
 struct ReducedSources {

@@ -22,7 +22,9 @@ namespace asval {
 
 // One job's parameters, as the shader reads them (struct Job of reduce_inputs.comp; 16-aligned in a slab).
 struct ReduceJob {
-  enum Kind : uint32_t { kTriangles = 0, kAabbs = 1, kInstances = 2 };
+  // kGatherInstances: an array of instance pointers at `data` (count of them): the pointers and the records they
+  // point to (those FollowedInstancePointer names; zeros for the others) copied to `out` (GatheredBytes).
+  enum Kind : uint32_t { kTriangles = 0, kAabbs = 1, kInstances = 2, kGatherInstances = 3 };
   enum XKind : uint32_t { kNoNaN = 0, kFloat32 = 1, kFloat16 = 2 };
   uint32_t kind = kTriangles;
   uint32_t count = 0;         // primitives
@@ -57,6 +59,18 @@ inline bool CaptureReduces(CaptureMethod method, VkPhysicalDeviceType type, bool
                            bool shader_objects, bool float_spacing) {
   if (!buffer_device_address || shader_objects || float_spacing) return false;
   return method == kCaptureMethodReduce || (method == kCaptureMethodAuto && type != VK_PHYSICAL_DEVICE_TYPE_CPU);
+}
+
+// Whether the layer's dispatch gathers the records of arrays of instance pointers (the second stage of their
+// capture: their addresses are on the device, read when the build executes, so no copy recorded beforehand can name
+// them), also where the capture copies: with capture_method reduce, or `auto` and `copy` on a device that is not a
+// CPU. Not on a CPU device unless asked (lavapipe loses the app's compute state once the layer's pipeline was bound:
+// capture.md), nor without bufferDeviceAddress or with shader objects (as CaptureReduces). Where it does not, the
+// records are unknown (skipped and counted).
+inline bool CaptureGathers(CaptureMethod method, VkPhysicalDeviceType type, bool buffer_device_address,
+                           bool shader_objects) {
+  if (!buffer_device_address || shader_objects) return false;
+  return method == kCaptureMethodReduce || type != VK_PHYSICAL_DEVICE_TYPE_CPU;
 }
 
 class CaptureReducer {

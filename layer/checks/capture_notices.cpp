@@ -114,7 +114,8 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
   const Location loc(OpCommandName(build.build.command));
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
-    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present || g.array_of_pointers) continue;
+    // Arrays of pointers: their gathered records (a record not followed is zeros: nothing to warn about).
+    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present) continue;
     const uint8_t* bytes = log->Bytes(g.data);
     if (spacing_permille != 0 && !g.reduced) {  // (never reduced: the capture copies when float_spacing is on)
       const FarInstances far = FindFarInstances(build, bytes, g.range.primitiveCount, spacing_permille);

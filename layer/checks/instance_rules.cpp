@@ -158,20 +158,22 @@ uint32_t CheckReferenced(const CheckContext& ctx, const InstanceReferenceCheck& 
   return findings + CheckAgainstDestinations(ctx, c, log, info, r, *structure, span);
 }
 
-// pInfos-03717: each pointer of an array of instance pointers is 16-byte aligned. The records the pointers
-// name are not captured: their references (and so the rules above) are unknown, counted.
+// pInfos-03717: each pointer of an array of instance pointers is 16-byte aligned. The records of those that are
+// not (and of null ones, which the layer does not follow either) were not gathered: counted as unknown once.
 void CheckInstancePointers(const CheckContext& ctx, const InstanceReferenceCheck& c, const CaptureLog& log,
                            uint32_t geometry, const CapturedGeometry& g) {
-  CountUnknownState(ctx);
-  const uint8_t* bytes = log.Bytes(g.data);
-  uint64_t misaligned = 0;
+  const uint8_t* pointers = log.Bytes(g.pointers);
+  const bool alignment = ctx.Enabled(kCheckAlignment);
+  uint64_t misaligned = 0, not_followed = 0;
   std::string named;
   for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
-    VkDeviceAddress pointer = 0;
-    std::memcpy(&pointer, bytes + static_cast<std::size_t>(k) * sizeof(pointer), sizeof(pointer));
-    if (pointer % 16 == 0) continue;
+    const VkDeviceAddress pointer = InstancePointer(pointers, k);
+    if (FollowedInstancePointer(pointer)) continue;
+    ++not_followed;
+    if (pointer == 0 || !alignment) continue;
     if (misaligned++ < kNamed) named += fmt::format("{}instance {} at 0x{:x}", misaligned > 1 ? ", " : "", k, pointer);
   }
+  if (not_followed != 0 && g.data.present) CountUnknownState(ctx);
   if (misaligned == 0) return;
   if (misaligned > kNamed) named += fmt::format(" (and {} more)", misaligned - kNamed);
   Report(ctx, c, "pInfos-03717", VK_NULL_HANDLE,
@@ -224,11 +226,15 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   if (per_structure) first.assign(live.structures.size(), Referenced{-1, 0, 0});
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     const CapturedGeometry& g = log->geometries[info.first_geometry + j];
-    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0 || !g.data.present) continue;
+    if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0) continue;
     if (g.array_of_pointers) {
-      if (ctx.Enabled(kCheckAlignment)) CheckInstancePointers(ctx, c, *log, j, g);
-      continue;
+      if (!g.pointers.present) continue;
+      CheckInstancePointers(ctx, c, *log, j, g);
+      // The records, gathered by the layer's dispatch, are then judged as a plain array's (a record not followed
+      // is zeros: inactive here, counted above); not gathered (capture.md says where): unknown.
+      if (!g.data.present) CountUnknownState(ctx);
     }
+    if (!g.data.present) continue;
     // Reduced on the device: each 64 records' distinct references, with the first record of each, are judged
     // instead of every record; only when one names no live structure are the records walked below (for the count
     // and the instances the message names).

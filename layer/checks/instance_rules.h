@@ -8,7 +8,8 @@
 //   dstAccelerationStructure-03706   no referenced structure's memory overlaps the bytes the command writes for
 //                                    another info's destination
 //   pInfos-03717                     arrays of instance pointers: each pointer is 16-byte aligned (the records
-//                                    they point to are not captured: the rules above are skipped, counted)
+//                                    they point to, gathered by the layer's dispatch, are judged by the rules above
+//                                    as a plain array's; where they are not gathered: skipped, counted)
 // Const: reports only; run under the device's capture processing lock.
 #include "build_activity.h"
 #include "check_context.h"

@@ -100,8 +100,8 @@ VKAPI_ATTR void VKAPI_CALL CmdBindPipeline(VkCommandBuffer commandBuffer, VkPipe
                                            VkPipeline pipeline) {
   DeviceData* data = GetDeviceData(commandBuffer);
   data->dispatch.CmdBindPipeline(commandBuffer, pipelineBindPoint, pipeline);
-  // Only where the layer's reducing dispatch may replace it (capture_reducer.h): elsewhere a pass-through.
-  if (pipelineBindPoint == VK_PIPELINE_BIND_POINT_COMPUTE && data->capture_pool && data->capture_pool->reduces()) {
+  // Only where the layer's dispatch may replace it (capture_reducer.h): elsewhere a pass-through.
+  if (pipelineBindPoint == VK_PIPELINE_BIND_POINT_COMPUTE && data->capture_pool && data->capture_pool->dispatches()) {
     RecordBindComputePipeline(data->state, commandBuffer, pipeline);
   }
 }

@@ -152,12 +152,14 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   // Execution-time capture: needs the history (its records live there).
   if (data->state.history_tracked && instance->settings.capture != kCaptureOff) {
-    const bool reduce = CaptureReduces(settings.capture_method, data->state.properties.core.deviceType,
-                                       data->state.features.buffer_device_address,
-                                       EnablesExtension(*pCreateInfo, "VK_EXT_shader_object"),
+    const VkPhysicalDeviceType type = data->state.properties.core.deviceType;
+    const bool address = data->state.features.buffer_device_address;
+    const bool shader_objects = EnablesExtension(*pCreateInfo, "VK_EXT_shader_object");
+    const bool reduce = CaptureReduces(settings.capture_method, type, address, shader_objects,
                                        (settings.capture_warnings & kCaptureWarnFloatSpacing) != 0);
+    const bool gather = CaptureGathers(settings.capture_method, type, address, shader_objects);
     data->capture_pool =
-        std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, reduce);
+        std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, reduce, gather);
     data->capture_tracker = std::make_unique<CaptureTracker>(*pDevice, data->dispatch);
   }
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));

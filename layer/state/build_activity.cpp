@@ -84,6 +84,16 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
   return true;
 }
 
+// Whether the layer's dispatch gathered the record of every pointer of a gathered array of instance pointers.
+bool EveryPointerFollowed(const CaptureLog& log, const CapturedGeometry& g) {
+  if (!g.pointers.present) return false;
+  const uint8_t* pointers = log.Bytes(g.pointers);
+  for (uint32_t k = 0; k < g.range.primitiveCount; ++k) {
+    if (!FollowedInstancePointer(InstancePointer(pointers, k))) return false;
+  }
+  return true;
+}
+
 // The builder's view of one captured geometry; false when its bytes were not captured.
 bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
               builder::ClassifyResult* out) {
@@ -98,7 +108,9 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
     if (g.index_type != VK_INDEX_TYPE_NONE_KHR && !g.indices.present) return false;
     result = builder::ClassifyTriangles(TriangleView(log, g), record, nullptr);
   } else if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
-    if (g.array_of_pointers) return false;  // the pointers only: the records they point to are not captured
+    // Arrays of pointers: their records, gathered, read as a plain array's (the same records give the same bits,
+    // so an update compares with its source whichever layout each used); a record not followed is unknown.
+    if (g.array_of_pointers && !EveryPointerFollowed(log, g)) return false;
     builder::InstanceGeometryView view;
     view.data = log.Bytes(g.data);
     view.dataBytes = g.data.size;

@@ -87,9 +87,13 @@ struct CapturedGeometry {
   uint32_t max_vertex = 0;
   VkIndexType index_type = VK_INDEX_TYPE_NONE_KHR;
   VkDeviceSize aabb_stride = 0;
-  // Instances given as an array of pointers: `data` holds the pointers (8 bytes each) the device read, not the
-  // records they point to, which the layer cannot locate when it records the copies.
+  // Instances given as an array of pointers: `pointers` holds the pointers (8 bytes each) the device read, and
+  // `data`, where the layer's dispatch gathered them (layer/capture: GatherInstancePointers), the records they point
+  // to, record k at 64 * k as in a plain array, so that everything after the capture reads them as one; a record
+  // whose pointer is not followed (FollowedInstancePointer) is zeros there and unknown. `data` absent: the records
+  // were not gathered (the capture copied the pointers only), their references and activity unknown.
   bool array_of_pointers = false;
+  CapturedBytes pointers;
   // Indirect infos: what the range rules judge their captured range by (pIndirectDeviceAddresses-03651) was kept
   // when the command was recorded: type, and for triangles vertex_format, index_type and max_vertex, the app's
   // own (max_vertex not rewritten: firstVertex is in the range, on the device). False: the geometry could not be
@@ -167,6 +171,18 @@ struct CommandDestination {
   VkDeviceAddress address = 0;  // 0: unknown
   MemorySpan accessed;          // the bytes this build writes (accelerationStructureSize); memory null: unknown
 };
+
+// Whether the layer's dispatch reads the record an instance pointer names (shaders/reduce_inputs.comp decides the
+// same): not 0 and aligned to 16 bytes (pInfos-03717; a misaligned one is reported, never chased). The build
+// itself reads 64 bytes there, right after the dispatch: the dispatch reads nothing the build would not read.
+inline bool FollowedInstancePointer(uint64_t pointer) { return pointer != 0 && pointer % 16 == 0; }
+inline uint64_t InstancePointer(const uint8_t* pointers, uint32_t k) {
+  uint64_t pointer = 0;
+  std::memcpy(&pointer, pointers + 8 * static_cast<std::size_t>(k), sizeof(pointer));
+  return pointer;
+}
+// What the gathering job writes for `count` pointers: the pointers, then the records (ReduceJob::kGatherInstances).
+inline VkDeviceSize GatheredBytes(uint32_t count) { return (8 + 64) * VkDeviceSize{count}; }
 
 // One captured build info (pInfos[i] of a recorded build command).
 struct CapturedInfo {

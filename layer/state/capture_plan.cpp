@@ -69,14 +69,16 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
   }
   if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
     const VkAccelerationStructureGeometryInstancesDataKHR& in = g.geometry.instances;
-    // Arrays of pointers: the pointers only (their alignment is a rule); where they point is known on the device
-    // alone, so the records themselves, and with them the references and the activity, stay unknown.
+    // Arrays of pointers: the pointers (their alignment is a rule); where they point is known on the device alone,
+    // when the build executes, so the records are a second stage, gathered on the device by the layer's dispatch
+    // where it has one (layer/capture), else unknown.
     out->array_of_pointers = in.arrayOfPointers == VK_TRUE;
     if (n == 0) return true;
     if (address(in.data) == 0) return false;
     const VkDeviceSize record_bytes = out->array_of_pointers ? sizeof(VkDeviceAddress) : kInstanceBytes;
     sources.push_back(CaptureSource{SaturatingAddBytes(address(in.data), r.primitiveOffset),
-                                    SaturatingMulBytes(record_bytes, n), &out->data});
+                                    SaturatingMulBytes(record_bytes, n),
+                                    out->array_of_pointers ? &out->pointers : &out->data});
     return true;
   }
   return false;

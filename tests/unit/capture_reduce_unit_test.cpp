@@ -1,5 +1,6 @@
-// Which devices reduce their captures on the device (capture_method, layer/capture/capture_reducer.h), and the
-// layout the host reads a reduced geometry's results in (ReducedGeometry, layer/state/capture_log.h).
+// Which devices reduce their captures on the device (capture_method, layer/capture/capture_reducer.h) and gather
+// arrays of instance pointers' records, and the layout the host reads a reduced geometry's results in
+// (ReducedGeometry, layer/state/capture_log.h).
 #include <catch2/catch_test_macros.hpp>
 
 #include <cstring>
@@ -28,6 +29,28 @@ TEST_CASE("capture reduce unit: never without bufferDeviceAddress, with shader o
     CHECK_FALSE(CaptureReduces(method, kGpu, true, true, false));
     CHECK_FALSE(CaptureReduces(method, kGpu, true, false, true));
   }
+}
+
+TEST_CASE("capture reduce unit: arrays of instance pointers are gathered wherever the layer may dispatch: any "
+          "method on a GPU, reduce on a CPU device; never without bufferDeviceAddress or with shader objects") {
+  for (CaptureMethod method : {kCaptureMethodAuto, kCaptureMethodCopy, kCaptureMethodReduce}) {
+    CHECK(CaptureGathers(method, kGpu, true, false));
+    CHECK(CaptureGathers(method, kCpu, true, false) == (method == kCaptureMethodReduce));
+    CHECK_FALSE(CaptureGathers(method, kGpu, false, false));
+    CHECK_FALSE(CaptureGathers(method, kGpu, true, true));
+  }
+}
+
+TEST_CASE("capture reduce unit: which instance pointers the layer follows, and the gathered layout") {
+  CHECK_FALSE(FollowedInstancePointer(0));
+  CHECK_FALSE(FollowedInstancePointer(0x1008));  // pInfos-03717: never chased
+  CHECK_FALSE(FollowedInstancePointer(0x1004));
+  CHECK(FollowedInstancePointer(0x1010));
+  CHECK(GatheredBytes(3) == 3 * 8 + 3 * 64);
+  const uint64_t pointers[2] = {0x2000, 0x2048};
+  uint8_t bytes[sizeof(pointers)];
+  std::memcpy(bytes, pointers, sizeof(pointers));
+  CHECK(InstancePointer(bytes, 1) == 0x2048);
 }
 
 TEST_CASE("capture reduce unit: a reduced geometry's bytes, and its bit arrays as the host reads them") {

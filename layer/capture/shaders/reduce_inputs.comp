@@ -8,7 +8,11 @@
 //   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
 //   instances  per record: its accelerationStructureReference, active (a reference other than 0), and whether
 //              its transform has a NaN or infinite element (per 32 records, the first such one's element too);
-//              per 64 records, each distinct reference other than 0 once, with the first record holding it.
+//              per 64 records, each distinct reference other than 0 once, with the first record holding it;
+//   arrays of instance pointers (job kind 3, the second stage of their capture: where they point is known only
+//              now): the pointers as they are, then per pointer the 64-byte record it names, copied, when it is
+//              not 0 and aligned to 16 bytes (FollowedInstancePointer, capture_log.h: the build reads those 64
+//              bytes right after this dispatch; a misaligned one is pInfos-03717 and never chased), else zeros.
 // Bit arrays hold one bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count. The
 // layout of the results is ReducedGeometry's (layer/state/capture_log.h).
 //
@@ -32,7 +36,7 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Add
 
 // Must match ReduceJob (layer/capture/capture_reducer.h).
 struct Job {
-  uint kind;          // 0 triangles, 1 AABBs, 2 instances
+  uint kind;          // 0 triangles, 1 AABBs, 2 instances, 3 arrays of instance pointers (gathered)
   uint count;         // primitives
   uint stride;        // vertex, AABB or instance stride in bytes
   uint x_kind;        // triangles: 0 no NaN (normalized formats), 1 float32, 2 float16
@@ -97,6 +101,26 @@ void main() {
       const uvec2 out_transform = AddProduct(out_indices, (index_total + 3u) / 4u, 4u);
       OutWords(AddProduct(out_transform, local, 4u)).w[0] = LoadBytes(AddProduct(job.transform, local, 4u), 4u);
     }
+  }
+  // Arrays of instance pointers: gathered, no bits (the host classifies the records as it does copied ones). The
+  // job is the group's, so the whole group returns here, before any barrier.
+  if (job.kind == 3u) {
+    const uvec2 out_records = AddProduct(job.out_addr, job.count, 8u);
+    for (uint t = gl_WorkGroupID.x * 64u + local; t < job.count; t += stride_x) {
+      const uvec2 at = AddProduct(job.data, t, 8u);
+      const uvec2 pointer = uvec2(LoadBytes(at, 4u), LoadBytes(Add64(at, 4u, 0u), 4u));
+      OutWords pointer_out = OutWords(AddProduct(job.out_addr, t, 8u));
+      pointer_out.w[0] = pointer.x;
+      pointer_out.w[1] = pointer.y;
+      const uvec2 record_out = AddProduct(out_records, t, 64u);
+      // A branch, not a select: the load must not be made for a pointer that is not followed.
+      if (pointer != uvec2(0u) && (pointer.x & 15u) == 0u) {
+        for (uint k = 0u; k < 16u; ++k) OutWords(AddProduct(record_out, k, 4u)).w[0] = Words(pointer).w[k];
+      } else {
+        for (uint k = 0u; k < 16u; ++k) OutWords(AddProduct(record_out, k, 4u)).w[0] = 0u;
+      }
+    }
+    return;
   }
   // Uniform over the group: every invocation takes part in each round's barriers.
   for (uint group_first = gl_WorkGroupID.x * 64u; group_first < job.count; group_first += stride_x) {
