@@ -88,6 +88,8 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->GetBufferDeviceAddress = reinterpret_cast<PFN_vkGetBufferDeviceAddress>(LoadFirst(gdpa, device, kGetBufferDeviceAddressNames));
   table->GetBufferMemoryRequirements = reinterpret_cast<PFN_vkGetBufferMemoryRequirements>(gdpa(device, "vkGetBufferMemoryRequirements"));
   table->GetDeferredOperationResultKHR = reinterpret_cast<PFN_vkGetDeferredOperationResultKHR>(gdpa(device, "vkGetDeferredOperationResultKHR"));
+  static constexpr const char* kGetDeviceBufferMemoryRequirementsNames[] = {"vkGetDeviceBufferMemoryRequirements", "vkGetDeviceBufferMemoryRequirementsKHR"};
+  table->GetDeviceBufferMemoryRequirements = reinterpret_cast<PFN_vkGetDeviceBufferMemoryRequirements>(LoadFirst(gdpa, device, kGetDeviceBufferMemoryRequirementsNames));
   table->GetDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(gdpa(device, "vkGetDeviceProcAddr"));
   table->GetDeviceQueue = reinterpret_cast<PFN_vkGetDeviceQueue>(gdpa(device, "vkGetDeviceQueue"));
   table->GetDeviceQueue2 = reinterpret_cast<PFN_vkGetDeviceQueue2>(gdpa(device, "vkGetDeviceQueue2"));

@@ -73,6 +73,7 @@ struct DeviceDispatchTable {
   PFN_vkGetBufferDeviceAddress GetBufferDeviceAddress = nullptr;
   PFN_vkGetBufferMemoryRequirements GetBufferMemoryRequirements = nullptr;
   PFN_vkGetDeferredOperationResultKHR GetDeferredOperationResultKHR = nullptr;
+  PFN_vkGetDeviceBufferMemoryRequirements GetDeviceBufferMemoryRequirements = nullptr;
   PFN_vkGetDeviceProcAddr GetDeviceProcAddr = nullptr;
   PFN_vkGetDeviceQueue GetDeviceQueue = nullptr;
   PFN_vkGetDeviceQueue2 GetDeviceQueue2 = nullptr;

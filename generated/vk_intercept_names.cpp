@@ -46,6 +46,8 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkFreeCommandBuffers",
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
+    "vkGetDeviceBufferMemoryRequirements",
+    "vkGetDeviceBufferMemoryRequirementsKHR",
     "vkGetFenceStatus",
     "vkGetQueryPoolResults",
     "vkGetSemaphoreCounterValue",
@@ -107,6 +109,8 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkFreeCommandBuffers
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR
+    true,  // vkGetDeviceBufferMemoryRequirements
+    true,  // vkGetDeviceBufferMemoryRequirementsKHR
     true,  // vkGetFenceStatus
     true,  // vkGetQueryPoolResults
     true,  // vkGetSemaphoreCounterValue

@@ -50,6 +50,8 @@ const InterceptEntry kIntercepts[] = {
     {"vkFreeCommandBuffers", reinterpret_cast<PFN_vkVoidFunction>(&FreeCommandBuffers), true},
     {"vkFreeMemory", reinterpret_cast<PFN_vkVoidFunction>(&FreeMemory), true},
     {"vkGetDeferredOperationResultKHR", reinterpret_cast<PFN_vkVoidFunction>(&GetDeferredOperationResultKHR), true},
+    {"vkGetDeviceBufferMemoryRequirements", reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceBufferMemoryRequirements), true},
+    {"vkGetDeviceBufferMemoryRequirementsKHR", reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceBufferMemoryRequirements), true},
     {"vkGetFenceStatus", reinterpret_cast<PFN_vkVoidFunction>(&GetFenceStatus), true},
     {"vkGetQueryPoolResults", reinterpret_cast<PFN_vkVoidFunction>(&GetQueryPoolResults), true},
     {"vkGetSemaphoreCounterValue", reinterpret_cast<PFN_vkVoidFunction>(&GetSemaphoreCounterValue), true},

@@ -184,11 +184,11 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
           SaturatingAddBytes(SaturatingMulBytes(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
       const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
       if (!within_budget) ++counts.over_budget;
-      const std::optional<AddressHit> hit =
-          within_budget ? CaptureSourceBuffer(ctx.state, addresses[i], bytes, CaptureRead::kCopy) : std::nullopt;
-      if (hit && Reserve(ctx, log, bytes, &entry.ranges)) {
-        copies.push_back(Copy{hit->buffer, log.BufferOf(entry.ranges),
-                              VkBufferCopy{addresses[i] - hit->base, entry.ranges.offset, bytes}});
+      const std::optional<CopySource> from =
+          within_budget ? CaptureCopySource(ctx.state, ctx.aliases, addresses[i], bytes) : std::nullopt;
+      if (from && Reserve(ctx, log, bytes, &entry.ranges)) {
+        copies.push_back(
+            Copy{from->buffer, log.BufferOf(entry.ranges), VkBufferCopy{from->offset, entry.ranges.offset, bytes}});
         ++counts.captured;
         counts.bytes += bytes;
       } else {
@@ -320,14 +320,13 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
       }
       for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
         const CaptureSource& s = sources[k];
-        const std::optional<AddressHit> hit = CaptureSourceBuffer(ctx.state, s.address, s.size, CaptureRead::kCopy);
-        if (!hit && s.optional) continue;
-        if (!hit || !Reserve(ctx, log, s.size, s.into)) {
+        const std::optional<CopySource> from = CaptureCopySource(ctx.state, ctx.aliases, s.address, s.size);
+        if (!from && s.optional) continue;
+        if (!from || !Reserve(ctx, log, s.size, s.into)) {
           entry.complete = false;
           break;
         }
-        copies.push_back(
-            Copy{hit->buffer, log.BufferOf(*s.into), VkBufferCopy{s.address - hit->base, s.into->offset, s.size}});
+        copies.push_back(Copy{from->buffer, log.BufferOf(*s.into), VkBufferCopy{from->offset, s.into->offset, s.size}});
       }
     }
     if (!entry.complete) {
@@ -387,18 +386,22 @@ uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer
   // The header (two UUIDs, then the serialized size, the deserialized size and the handle count): less than it
   // can never be hashed.
   constexpr VkDeviceSize kHeaderBytes = 2 * VK_UUID_SIZE + 3 * sizeof(uint64_t);
-  // The copyable buffer holding `address` that reaches furthest past it. Inline hits: no allocation.
+  // The bound buffer holding `address` that reaches furthest past it, read through what the layer may name there
+  // (capture_buffers.h). Inline hits: no allocation.
   AddressHits hits;
   ctx.state.buffer_addresses.FindContaining(address, hits);
-  std::optional<AddressHit> from;
+  std::optional<CopySource> from;
   VkDeviceSize capacity = 0;
   for (const AddressHit& hit : hits) {
     const VkDeviceSize remaining = hit.base + hit.size - address;
     if (remaining <= capacity) continue;
     std::optional<std::shared_ptr<const BufferState>> b = ctx.state.buffers.find(hit.buffer);
-    if (!b || !*b || !(*b)->bound || !(*b)->capture_source) continue;
-    from = hit;
-    capacity = remaining;
+    if (!b || !*b || !(*b)->bound || (*b)->memory == VK_NULL_HANDLE) continue;
+    const std::optional<CopySource> source =
+        CopySourceIn(ctx.state, ctx.aliases, **b, hit.base, hit.size, address, kHeaderBytes);
+    if (!source || source->bytes_left <= capacity) continue;
+    from = source;
+    capacity = source->bytes_left;
   }
   if (!from) {
     ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
@@ -429,7 +432,7 @@ uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer
   // One copy: a single-element array of the thread's, as the builds' captures keep theirs (no allocation).
   thread_local std::vector<Copy> copies;
   copies.clear();
-  copies.push_back(Copy{from->buffer, log.BufferOf(into), VkBufferCopy{address - from->base, into.offset, bytes}});
+  copies.push_back(Copy{from->buffer, log.BufferOf(into), VkBufferCopy{from->offset, into.offset, bytes}});
   const uint32_t blob = log.AddBlob(into);  // before the copy is recorded: it may allocate
   RecordCopies(ctx, cb, copies);
   ctx.counters.blobs_captured.fetch_add(1, std::memory_order_relaxed);

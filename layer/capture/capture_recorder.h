@@ -23,6 +23,7 @@
 #include "capture_pool.h"
 #include "device_state.h"
 #include "layer_settings.h"
+#include "memory_aliases.h"
 #include "vk_dispatch_table.h"
 
 namespace asval {
@@ -31,6 +32,7 @@ struct CaptureContext {
   const DeviceState& state;
   const DeviceDispatchTable& next;
   CapturePool& pool;
+  MemoryAliases& aliases;  // what the copies read through (memory_aliases.h)
   CaptureMode mode;
   VkDeviceSize budget_bytes;  // per recording
   CaptureCounters& counters;
@@ -67,10 +69,10 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
 // vkCmdCopyMemoryToAccelerationStructureKHR: called BEFORE the app's deserialization (what it will read), with src
 // VK_NULL_HANDLE. How many bytes: the blob's size is in its header on the device, unknown here; the copy takes the
 // serialization size when the app read it back for src's current contents (else the size of the last blob the
-// layer saw serialized at `address`), at most what the copyable buffer holding `address` has left, and at most
+// layer saw serialized at `address`), at most what the app's buffer holding `address` has left, and at most
 // what the recording's budget has left (a copy that turns out shorter than the header's size leaves the bytes
-// unknown, never guessed). Only buffers the capture may copy from (BufferState::capture_source: created with
-// TRANSFER_SRC). Returns the blob's index in recording.capture_log->blobs plus one; 0 when nothing was captured.
+// unknown, never guessed). Read through the layer's buffer over the memory (capture_buffers.h); in a dedicated
+// allocation only from a buffer created with TRANSFER_SRC (BufferState::capture_source). Returns the blob's index in recording.capture_log->blobs plus one; 0 when nothing was captured.
 uint32_t CaptureSerializedBlob(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                                VkDeviceAddress address, VkAccelerationStructureKHR src);
 

@@ -127,7 +127,7 @@ VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& source
 bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
                     JobBlock& block) {
   const auto readable = [&](const CaptureSource* s) {
-    return s && CaptureSourceBuffer(state, s->address, s->size, CaptureRead::kInPlace).has_value();
+    return s && BoundBufferCovering(state, s->address, s->size).has_value();
   };
   const CaptureSource* indices = sources.indices;
   const CaptureSource* transform = readable(sources.transform) ? sources.transform : nullptr;  // optional

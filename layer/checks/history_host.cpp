@@ -133,8 +133,8 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
     reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                     {Obj(VK_OBJECT_TYPE_DEVICE, device)},
                     fmt::format("Execution-time capture of device serialization: serialized bytes captured {} times "
-                                "(serializations and deserializations), not captured {} times (a buffer created "
-                                "without TRANSFER_SRC, or over capture_budget_mb); {} "
+                                "(serializations and deserializations), not captured {} times (memory the layer "
+                                "could not read, or over capture_budget_mb); {} "
                                 "deserializations of device bytes restored their history (the bytes read matched "
                                 "what was serialized there), {} left it unknown.",
                                 blobs, blobs_missed,

@@ -1,5 +1,6 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include "capture_usage.h"
 #include "footprint_report.h"
 #include "history_host.h"
 #include "layer_data.h"
@@ -23,6 +24,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     data->capture_tracker.reset();
     data->capture_pool->Shutdown();  // before the device goes; recordings still holding slabs give them back later
   }
+  if (data && data->capture_aliases) data->capture_aliases->Shutdown();  // the layer's buffers over app memory
   if (data) {
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
@@ -55,25 +57,38 @@ VKAPI_ATTR VkResult VKAPI_CALL AllocateMemory(VkDevice device, const VkMemoryAll
 VKAPI_ATTR void VKAPI_CALL FreeMemory(VkDevice device, VkDeviceMemory memory, const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
   if (memory) RecordFreeMemory(data->state, memory);
+  // After the state forgot the memory (no alias can be made for it from here) and before the downcall: the
+  // layer's buffer over it goes first (memory_aliases.h).
+  if (memory && data->capture_aliases) data->capture_aliases->Forget(memory);
   data->dispatch.FreeMemory(device, memory, pAllocator);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice device, const VkBufferCreateInfo* pCreateInfo,
                                             const VkAllocationCallbacks* pAllocator, VkBuffer* pBuffer) {
   DeviceData* data = GetDeviceData(device);
-  // Build inputs are copied by the capture (layer/capture): such buffers get TRANSFER_SRC, before the app asks
-  // for their memory requirements. A usage given by a pNext structure (VK_KHR_maintenance5) is left as it is.
+  // Build inputs get TRANSFER_SRC for the capture (capture_usage.h), before the app asks for their requirements.
   VkBufferCreateInfo info = *pCreateInfo;
-  const bool usage_here = !FindInChain<BufferUsageFlags2CreateInfo>(info.pNext, kBufferUsageFlags2CreateInfo);
-  if (data->capture_tracker && usage_here &&
-      (info.usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR)) {
-    info.usage |= VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-  }
+  if (AddsCopyUsage(data->capture_tracker != nullptr, info)) info.usage |= VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
   const VkResult result = data->dispatch.CreateBuffer(device, &info, pAllocator, pBuffer);
-  if (result == VK_SUCCESS) {
-    RecordCreateBuffer(data->state, *pCreateInfo, *pBuffer, usage_here && (info.usage & VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
-  }
+  if (result == VK_SUCCESS) RecordCreateBuffer(data->state, *pCreateInfo, *pBuffer, CreatedCopyable(info));
   return result;
+}
+
+// vkGetDeviceBufferMemoryRequirements and its KHR alias: answered for the create info vkCreateBuffer would pass
+// down (capture_usage.h), so that memory sized by it fits the buffer the app then creates.
+VKAPI_ATTR void VKAPI_CALL GetDeviceBufferMemoryRequirements(VkDevice device,
+                                                             const VkDeviceBufferMemoryRequirements* pInfo,
+                                                             VkMemoryRequirements2* pMemoryRequirements) {
+  DeviceData* data = GetDeviceData(device);
+  if (pInfo && pInfo->pCreateInfo && AddsCopyUsage(data->capture_tracker != nullptr, *pInfo->pCreateInfo)) {
+    VkBufferCreateInfo info = *pInfo->pCreateInfo;
+    info.usage |= VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+    VkDeviceBufferMemoryRequirements changed = *pInfo;
+    changed.pCreateInfo = &info;
+    data->dispatch.GetDeviceBufferMemoryRequirements(device, &changed, pMemoryRequirements);
+    return;
+  }
+  data->dispatch.GetDeviceBufferMemoryRequirements(device, pInfo, pMemoryRequirements);
 }
 
 VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice device, VkBuffer buffer, const VkAllocationCallbacks* pAllocator) {

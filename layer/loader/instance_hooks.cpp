@@ -2,6 +2,7 @@
 // reporter, and the app's debug messengers.
 #include <vulkan/vk_layer.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "layer_data.h"
@@ -54,6 +55,25 @@ void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, D
     d.GetPhysicalDeviceProperties(gpu, &out->core);
   }
   out->acceleration_structure.pNext = nullptr;
+  // The largest buffer (the capture's buffers over the app's memory, memory_aliases.h): a 1.3 structure, asked
+  // for only where both the instance and the device are 1.3.
+  if (d.GetPhysicalDeviceProperties2 && instance.api_version >= VK_API_VERSION_1_3 &&
+      out->core.apiVersion >= VK_API_VERSION_1_3) {
+    VkPhysicalDeviceMaintenance4Properties maintenance4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &maintenance4, {}};
+    d.GetPhysicalDeviceProperties2(gpu, &props2);
+    if (maintenance4.maxBufferSize != 0) out->max_buffer_size = maintenance4.maxBufferSize;
+  }
+}
+
+// The queue families the device is created with queues of, each once.
+std::vector<uint32_t> QueueFamilies(const VkDeviceCreateInfo& info) {
+  std::vector<uint32_t> families;
+  for (uint32_t k = 0; info.pQueueCreateInfos && k < info.queueCreateInfoCount; ++k) {
+    const uint32_t family = info.pQueueCreateInfos[k].queueFamilyIndex;
+    if (std::find(families.begin(), families.end(), family) == families.end()) families.push_back(family);
+  }
+  return families;
 }
 
 // Whether the app enabled a device extension.
@@ -148,6 +168,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
        (settings.capture_warnings & kCaptureWarnFloatSpacing));
   data->state.features = ParseEnabledFeatures(*pCreateInfo);
   QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
+  data->state.properties.queue_families = QueueFamilies(*pCreateInfo);
   data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);
   // Execution-time capture: needs the history (its records live there).
@@ -161,6 +182,9 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
     data->capture_pool =
         std::make_shared<CapturePool>(*pDevice, data->dispatch, data->state.properties.memory, reduce, gather);
     data->capture_tracker = std::make_unique<CaptureTracker>(*pDevice, data->dispatch);
+    data->capture_aliases = std::make_unique<MemoryAliases>(*pDevice, data->dispatch,
+                                                             data->state.properties.queue_families,
+                                                             data->state.properties.max_buffer_size);
   }
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));
   return VK_SUCCESS;

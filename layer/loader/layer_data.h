@@ -39,12 +39,14 @@ struct DeviceData {
   // The tracker is destroyed before the pool (declaration order).
   std::shared_ptr<CapturePool> capture_pool;
   std::unique_ptr<CaptureTracker> capture_tracker;
+  // The layer's buffers over the app's memory that the capture's copies read through (memory_aliases.h).
+  std::unique_ptr<MemoryAliases> capture_aliases;
 };
 
 // What the capture's pre-record of a build sees.
 inline CaptureContext MakeCaptureContext(DeviceData& data) {
   const LayerSettings& settings = data.instance->settings;
-  return CaptureContext{data.state, data.dispatch, *data.capture_pool, settings.capture,
+  return CaptureContext{data.state, data.dispatch, *data.capture_pool, *data.capture_aliases, settings.capture,
                         VkDeviceSize{settings.capture_budget_mb} << 20, data.state.capture_counters};
 }
 

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "address_map.h"
 #include "build_size_cache.h"
@@ -37,6 +38,11 @@ struct DeviceProperties {
   VkPhysicalDeviceProperties core{};
   VkPhysicalDeviceAccelerationStructurePropertiesKHR acceleration_structure{};
   VkPhysicalDeviceMemoryProperties memory{};
+  // VkPhysicalDeviceMaintenance4Properties::maxBufferSize where the instance and the device are 1.3; else 2^30, the
+  // least any implementation allows.
+  VkDeviceSize max_buffer_size = VkDeviceSize{1} << 30;
+  // The queue families the device has queues of (its VkDeviceQueueCreateInfos), each once.
+  std::vector<uint32_t> queue_families;
 };
 
 class DeviceState {

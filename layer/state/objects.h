@@ -17,6 +17,13 @@ struct MemoryState {
   // Allocated with multiple instances (a device group): VkMemoryAllocateFlagsInfo::deviceMask with more than
   // one bit, or, without DEVICE_MASK_BIT, a MULTI_INSTANCE heap on a device over several physical devices.
   bool multi_instance = false;
+  // The layer may bind a buffer of its own to it (the capture's copies read through one: layer/capture's
+  // MemoryAliases): not protected, not a dedicated allocation, not exported or imported, and nothing else in the
+  // allocation's pNext chain that the layer does not know (VUID-vkBindBufferMemory-memory-01508, 01509, 02726,
+  // 02985, None-01899).
+  bool layer_may_bind = false;
+  // VkMemoryDedicatedAllocateInfo::buffer: the one buffer that can ever be bound to it.
+  VkBuffer dedicated_buffer = VK_NULL_HANDLE;
 };
 
 struct BufferState {
@@ -27,7 +34,8 @@ struct BufferState {
   VkDeviceSize size = 0;
   VkBufferUsageFlags usage = 0;
   VkBufferCreateFlags create_flags = 0;
-  // Created with TRANSFER_SRC usage, the app's or added by the layer (vkCreateBuffer): the capture may copy it.
+  // Created with TRANSFER_SRC usage, the app's or added by the layer (vkCreateBuffer): the capture may copy from it
+  // where it is bound to a dedicated allocation (elsewhere it copies through a buffer of its own over the memory).
   bool capture_source = false;
   // Binding, set by vkBindBufferMemory(2); a sparse buffer is never "bound" this way.
   bool bound = false;

@@ -28,6 +28,34 @@ void ForgetFailed(const DeviceState& state) {
 
 namespace {
 
+// Whether a buffer of the layer's may be bound to memory allocated with `info` (MemoryState::layer_may_bind), and
+// the buffer a dedicated allocation is for. Any structure in the chain that is not listed here (an import, an
+// export with handle types, a vendor's) makes the memory one the layer leaves alone.
+bool LayerMayBind(const VkMemoryAllocateInfo& info, VkMemoryPropertyFlags property_flags, VkBuffer* dedicated_buffer) {
+  bool may = (property_flags & VK_MEMORY_PROPERTY_PROTECTED_BIT) == 0;
+  for (auto* s = static_cast<const VkBaseInStructure*>(info.pNext); s; s = s->pNext) {
+    switch (s->sType) {
+      case VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO:
+      case VK_STRUCTURE_TYPE_MEMORY_PRIORITY_ALLOCATE_INFO_EXT:
+      case VK_STRUCTURE_TYPE_MEMORY_OPAQUE_CAPTURE_ADDRESS_ALLOCATE_INFO:
+        break;
+      case VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO: {
+        auto* dedicated = reinterpret_cast<const VkMemoryDedicatedAllocateInfo*>(s);
+        if (dedicated->buffer != VK_NULL_HANDLE || dedicated->image != VK_NULL_HANDLE) may = false;
+        *dedicated_buffer = dedicated->buffer;
+        break;
+      }
+      case VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO:
+        if (reinterpret_cast<const VkExportMemoryAllocateInfo*>(s)->handleTypes != 0) may = false;
+        break;
+      default:
+        may = false;
+        break;
+    }
+  }
+  return may;
+}
+
 void AllocateMemoryRecord(DeviceState& state, const VkMemoryAllocateInfo& info, VkDeviceMemory memory) {
   InjectBadAlloc(FailSite::kObjectRecord);
   auto record = std::make_shared<MemoryState>();
@@ -37,6 +65,8 @@ void AllocateMemoryRecord(DeviceState& state, const VkMemoryAllocateInfo& info, 
   if (info.memoryTypeIndex < state.properties.memory.memoryTypeCount) {
     record->property_flags = state.properties.memory.memoryTypes[info.memoryTypeIndex].propertyFlags;
   }
+  record->layer_may_bind = info.memoryTypeIndex < state.properties.memory.memoryTypeCount &&
+                           LayerMayBind(info, record->property_flags, &record->dedicated_buffer);
   auto* flags = FindInChain<VkMemoryAllocateFlagsInfo>(info.pNext, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
   if (flags) record->allocate_flags = flags->flags;
   if (flags && (flags->flags & VK_MEMORY_ALLOCATE_DEVICE_MASK_BIT)) {

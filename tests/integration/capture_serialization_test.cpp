@@ -228,14 +228,17 @@ TEST_CASE("capture: an update submitted with the deserialization, before its com
   CHECK(json.find("history checks were skipped because the history they need was unknown") != std::string::npos);
 }
 
-TEST_CASE("capture: bytes deserialized from a buffer the layer may not copy leave the history unknown, counted",
-          "[integration][capture][history][passes-invalid-down]") {
+// Issue 25, item 6: the blob is copied through the layer's own buffer over the memory (layer/capture/
+// memory_aliases.h), so a serialization buffer needs no usage of its own (it used to need the app's TRANSFER_SRC,
+// and such bytes were left unknown).
+TEST_CASE("capture: bytes deserialized from a buffer without TRANSFER_SRC are captured through the layer's buffer "
+          "over its memory, and the history comes back (primitiveCount-03769)",
+          "[integration][capture][history]") {
   const std::string json = Summary([](HistoryFixture& f) {
     vkkit::Device& device = f.device();
     Inputs inputs(device);
     Blas original(device, inputs), restored(device, inputs);
     Commands commands(device);
-    // No TRANSFER_SRC: the layer does not add it to buffers that no usage marks as serialization buffers.
     vkkit::Buffer blob = device.CreateBuffer(1 << 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     VkCommandBuffer cb = commands.Begin();
     original.Build(cb, OneTriangle());
@@ -245,14 +248,17 @@ TEST_CASE("capture: bytes deserialized from a buffer the layer may not copy leav
     CmdDeserialize(device, cb, blob.address, restored.handle());
     commands.End(cb);
     REQUIRE(commands.Submit(cb) == VK_SUCCESS);
+    CHECK(f.monitor().Verify() == "");
+    // The restored structure's last build is the original's (one triangle): an update with two is reported.
+    f.monitor().Expect(kPrimitiveCount);
     CHECK(commands.Submit(RecordWith(commands, [&](VkCommandBuffer u) { restored.Update(u, TwoTriangles()); })) ==
-          VK_SUCCESS);
+          VK_ERROR_VALIDATION_FAILED_EXT);
     CHECK(f.monitor().Verify() == "");
     device.Destroy(blob);
   });
-  CHECK(json.find("serialized bytes captured 0 times (serializations and deserializations), not captured 2 "
+  CHECK(json.find("serialized bytes captured 2 times (serializations and deserializations), not captured 0 "
                   "times") != std::string::npos);
-  CHECK(json.find("history checks were skipped because the history they need was unknown") != std::string::npos);
+  CHECK(json.find("1 deserializations of device bytes restored their history") != std::string::npos);
 }
 
 }  // namespace

@@ -467,8 +467,9 @@ TEST_CASE("indirect capture unit: the recorder keeps each geometry's range facts
   // No memory type: the pool gives no slab. No buffer holds the address either, so the info is logged as not
   // captured; its geometries' facts are kept all the same (what this test reads).
   const auto pool = std::make_shared<CapturePool>(VK_NULL_HANDLE, next, VkPhysicalDeviceMemoryProperties{});
+  MemoryAliases aliases(VK_NULL_HANDLE, next, {}, VkDeviceSize{1} << 30);
   CaptureCounters counters;
-  const CaptureContext ctx{h.state(), next, *pool, kCaptureUpdates, VkDeviceSize{1} << 20, counters};
+  const CaptureContext ctx{h.state(), next, *pool, aliases, kCaptureUpdates, VkDeviceSize{1} << 20, counters};
   CommandBufferState recording(VK_NULL_HANDLE, VK_COMMAND_BUFFER_LEVEL_PRIMARY, false);
 
   VkAccelerationStructureGeometryKHR triangles{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
