@@ -92,7 +92,7 @@ bool Gatherable(const CapturedGeometry& g) {
 
 bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
                             const CaptureSource& pointers, JobBlock& block) {
-  if (!CaptureSourceBuffer(state, pointers.address, pointers.size, CaptureRead::kInPlace) ||
+  if (!BoundBufferCovering(state, pointers.address, pointers.size) ||
       block.dispatch.jobs >= block.capacity) {
     return false;
   }
