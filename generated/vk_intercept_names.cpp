@@ -31,6 +31,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateDevice",
     "vkCreateInstance",
     "vkCreateQueryPool",
+    "vkCreateSemaphore",
     "vkDeferredOperationJoinKHR",
     "vkDestroyAccelerationStructureKHR",
     "vkDestroyBuffer",
@@ -41,6 +42,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyFence",
     "vkDestroyInstance",
     "vkDestroyQueryPool",
+    "vkDestroySemaphore",
     "vkDeviceWaitIdle",
     "vkEndCommandBuffer",
     "vkFreeCommandBuffers",
@@ -50,7 +52,9 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkGetQueryPoolResults",
     "vkGetSemaphoreCounterValue",
     "vkGetSemaphoreCounterValueKHR",
+    "vkImportSemaphoreFdKHR",
     "vkMapMemory",
+    "vkQueueBindSparse",
     "vkQueueSubmit",
     "vkQueueSubmit2",
     "vkQueueSubmit2KHR",
@@ -59,6 +63,8 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkResetCommandPool",
     "vkResetFences",
     "vkSetDebugUtilsObjectNameEXT",
+    "vkSignalSemaphore",
+    "vkSignalSemaphoreKHR",
     "vkUnmapMemory",
     "vkWaitForFences",
     "vkWaitSemaphores",
@@ -92,6 +98,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     false,  // vkCreateDevice
     false,  // vkCreateInstance
     true,  // vkCreateQueryPool
+    true,  // vkCreateSemaphore
     true,  // vkDeferredOperationJoinKHR
     true,  // vkDestroyAccelerationStructureKHR
     true,  // vkDestroyBuffer
@@ -102,6 +109,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkDestroyFence
     false,  // vkDestroyInstance
     true,  // vkDestroyQueryPool
+    true,  // vkDestroySemaphore
     true,  // vkDeviceWaitIdle
     true,  // vkEndCommandBuffer
     true,  // vkFreeCommandBuffers
@@ -111,7 +119,9 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkGetQueryPoolResults
     true,  // vkGetSemaphoreCounterValue
     true,  // vkGetSemaphoreCounterValueKHR
+    true,  // vkImportSemaphoreFdKHR
     true,  // vkMapMemory
+    true,  // vkQueueBindSparse
     true,  // vkQueueSubmit
     true,  // vkQueueSubmit2
     true,  // vkQueueSubmit2KHR
@@ -120,6 +130,8 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkResetCommandPool
     true,  // vkResetFences
     true,  // vkSetDebugUtilsObjectNameEXT
+    true,  // vkSignalSemaphore
+    true,  // vkSignalSemaphoreKHR
     true,  // vkUnmapMemory
     true,  // vkWaitForFences
     true,  // vkWaitSemaphores

@@ -1,5 +1,7 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include <mutex>
+
 #include "footprint_report.h"
 #include "history_host.h"
 #include "layer_data.h"
@@ -24,6 +26,11 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     data->capture_pool->Shutdown();  // before the device goes; recordings still holding slabs give them back later
   }
   if (data) {
+    {
+      // Batches still waiting for a semaphore value nobody signaled (the device is idle: they never ran).
+      std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
+      data->state.history.order.NeverResolved();
+    }
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
   }
