@@ -52,7 +52,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   SubmissionOrder& order = data.state.history.order;
   std::unique_lock<std::recursive_mutex> order_lock;  // declared before the submission: released after it
   std::optional<SubmissionOrder::Call> call;
-  if (data.state.history_tracked && order.engaged(has_semaphores())) {
+  if (data.state.history_tracked && (order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
     order_lock = std::unique_lock<std::recursive_mutex>(data.state.history.submission_order);
     call.emplace(order, queue, function);
   }
@@ -72,9 +72,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
         try {
           HoldDeferredLogs(*ops, submission.captures());
         } catch (const std::bad_alloc&) {
-          // Not held: the recording's next submission may read bytes this one rewrites. Unknown instead.
           data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
-          for (const std::shared_ptr<CaptureLog>& log : ops->capture_logs) log->SubmissionStarted();
         }
       }
     });
@@ -176,7 +174,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueBindSparse(VkQueue queue, uint32_t bindInfoC
     }
     return false;
   };
-  if (!data->state.history_tracked || !order.engaged(has_semaphores())) {
+  if (!data->state.history_tracked || !(order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
     return data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence);
   }
   std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);

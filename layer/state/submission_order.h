@@ -16,8 +16,9 @@
 // operations unknown (the caller makes every structure's history unknown; the checks are skipped and counted).
 // Deferred batches still waiting at vkDestroyDevice are counted (NeverResolved).
 //
-// Guarded by HistoryState::submission_order (the caller holds it), except engaged(), which is read without it so
-// that submissions without semaphores on a device without timeline semaphores pay one atomic load.
+// Guarded by HistoryState::submission_order (the caller holds it), except any_timeline() and backlog(), which are
+// read without it so that a submission without semaphores, or on a device without timeline semaphores, pays two
+// atomic loads while nothing is deferred.
 #include <vulkan/vulkan.h>
 
 #include <atomic>
@@ -94,11 +95,8 @@ struct OrderCounters {
 
 class SubmissionOrder {
  public:
-  // Without the lock: whether a submission must go through Place (false: apply in host order, nothing to note).
-  bool engaged(bool has_semaphores) const {
-    return backlog_size_.load(std::memory_order_acquire) != 0 ||
-           (has_semaphores && timelines_.load(std::memory_order_acquire) != 0);
-  }
+  // Without the lock: a submission must go through Call::Place when batches are deferred (backlog()), or when it
+  // has semaphores and the device has timeline semaphores; otherwise it is applied in host order, nothing noted.
   bool any_timeline() const { return timelines_.load(std::memory_order_acquire) != 0; }
 
   // vkCreateSemaphore of a timeline semaphore; `external`: created exportable (another process may signal it).
