@@ -4,7 +4,9 @@
 // queue is checked after it, the way the device runs them; and completion is processed per queue.
 #include <catch2/catch_test_macros.hpp>
 
+#include <atomic>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "capture_tracker.h"
@@ -24,7 +26,7 @@ int g_table;  // its address is the dispatch key shared by the fake device, queu
 FakeDispatchable g_device_object{&g_table}, g_queue_objects[2] = {{&g_table}, {&g_table}},
     g_cb_objects[4] = {{&g_table}, {&g_table}, {&g_table}, {&g_table}};
 
-int g_submits = 0;
+std::atomic<int> g_submits{0};
 uint64_t g_next_semaphore = 100;
 
 VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t, const VkSubmitInfo*, VkFence) {
@@ -311,6 +313,30 @@ TEST_CASE("order: batches never signaled before the device goes are counted", "[
   }
   CHECK(d.state().history.order.counters.batches_never_resolved == 1);
   CHECK(d.state().history.order.backlog() == 0);
+}
+
+TEST_CASE("order: two threads, one queue's waits signaled by the other's submissions as they come",
+          "[order][history][hook][threads]") {
+  TwoQueues d;
+  const VkSemaphore timeline = d.Timeline();
+  d.Record(0, 1, false);
+  REQUIRE(d.Submit(0, 0) == VK_SUCCESS);
+  d.Record(1, 1, true);   // queue 0: an update, each waiting for the next value
+  d.Record(2, 1, false);  // queue 1: a build, each signaling the next value
+  constexpr uint64_t kRounds = 200;
+  std::atomic<int> failed{0};  // Catch2's assertions are not thread-safe: counted here, checked after
+  std::thread waiter([&] {
+    for (uint64_t i = 1; i <= kRounds; ++i) failed += d.Submit(0, 1, timeline, i) != VK_SUCCESS;
+  });
+  std::thread signaler([&] {
+    for (uint64_t i = 1; i <= kRounds; ++i) failed += d.Submit(1, 2, VK_NULL_HANDLE, 0, timeline, i) != VK_SUCCESS;
+  });
+  waiter.join();
+  signaler.join();
+  CHECK(failed == 0);
+  CHECK(d.vuids.empty());
+  CHECK(d.state().history.order.backlog() == 0);
+  CHECK(g_submits == 1 + 2 * static_cast<int>(kRounds));
 }
 
 // Completion: one queue's pending submission no longer holds back another queue's completed one.
