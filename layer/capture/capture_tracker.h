@@ -60,8 +60,8 @@ class CaptureTracker {
   // reset or destroy a fence only then), and the handle no longer names them.
   void FenceRetired(VkFence app_fence);
   // Processes, in submission order per queue, every submission that completed, and those `covered` names (waiting
-  // for their layer fence); on each queue, stops at the first one still pending. A call made while this thread is processing (from
-  // an app callback) does nothing.
+  // for their layer fence); on each queue, stops at the first one still pending. A call made while this thread is
+  // processing (from an app callback) does nothing.
   void Process(const Covered& covered, const OnComplete& on_complete);
   // Adds its pending submissions and spare fences to the layer's footprint (footprint.h).
   void AddFootprint(CaptureFootprint* out) const;

@@ -20,8 +20,8 @@ namespace asval::hooks {
 
 namespace {
 
-// The capture logs a deferred (or unordered) command buffer's copies write, counted pending with the call's captures so that
-// another submission of the same recording is not read while the device may write them (capture_tracker.h).
+// The capture logs a deferred (or unordered) command buffer's copies write, counted pending with the call's captures
+// so that another submission of the same recording is not read while the device may write them (capture_tracker.h).
 void HoldDeferredLogs(const RecordedOps& ops, SubmissionCaptures& captures) {
   for (const std::shared_ptr<CaptureLog>& log : ops.capture_logs) {
     bool known = false;

@@ -35,7 +35,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateSemaphore(VkDevice device, const VkSemaphor
 VKAPI_ATTR void VKAPI_CALL DestroySemaphore(VkDevice device, VkSemaphore semaphore,
                                             const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
-  if (semaphore && data->state.history_tracked && (data->state.history.order.any_timeline() || data->state.history.order.backlog() != 0)) {
+  const SubmissionOrder& order = data->state.history.order;
+  if (semaphore && data->state.history_tracked && (order.any_timeline() || order.backlog() != 0)) {
     std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
     data->state.history.order.SemaphoreDestroyed(semaphore);
   }

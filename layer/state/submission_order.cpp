@@ -20,7 +20,8 @@ SemaphoreUse BatchSemaphores::Signal(uint32_t i) const {
 namespace {
 
 void AddTimelineValues(const void* chain, BatchSemaphores* out) {
-  const auto* values = FindInChain<VkTimelineSemaphoreSubmitInfo>(chain, VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO);
+  const auto* values =
+      FindInChain<VkTimelineSemaphoreSubmitInfo>(chain, VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO);
   if (!values) return;
   out->wait_values = values->pWaitSemaphoreValues;
   out->wait_value_count = values->waitSemaphoreValueCount;
