@@ -42,7 +42,7 @@ inline void ApplyDeferredBatch(DeviceData& data, const DeferredBatch& batch, boo
   }
   const ProtectScope protect(data.reporter->protects());
   checks.ReportAll();  // the batch went down already: a VK_TRUE cannot keep it from the driver
-  HaltSubmissionsAfter(data, protect);
+  HaltSubmissionsAfter(data, protect, /*deferred=*/true);
 }
 
 // Every deferred batch whose waits are now met, in execution order.
