@@ -66,6 +66,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateFence = reinterpret_cast<PFN_vkCreateFence>(gdpa(device, "vkCreateFence"));
   table->CreatePipelineLayout = reinterpret_cast<PFN_vkCreatePipelineLayout>(gdpa(device, "vkCreatePipelineLayout"));
   table->CreateQueryPool = reinterpret_cast<PFN_vkCreateQueryPool>(gdpa(device, "vkCreateQueryPool"));
+  table->CreateSemaphore = reinterpret_cast<PFN_vkCreateSemaphore>(gdpa(device, "vkCreateSemaphore"));
   table->CreateShaderModule = reinterpret_cast<PFN_vkCreateShaderModule>(gdpa(device, "vkCreateShaderModule"));
   table->DeferredOperationJoinKHR = reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(gdpa(device, "vkDeferredOperationJoinKHR"));
   table->DestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(gdpa(device, "vkDestroyAccelerationStructureKHR"));
@@ -77,6 +78,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->DestroyPipeline = reinterpret_cast<PFN_vkDestroyPipeline>(gdpa(device, "vkDestroyPipeline"));
   table->DestroyPipelineLayout = reinterpret_cast<PFN_vkDestroyPipelineLayout>(gdpa(device, "vkDestroyPipelineLayout"));
   table->DestroyQueryPool = reinterpret_cast<PFN_vkDestroyQueryPool>(gdpa(device, "vkDestroyQueryPool"));
+  table->DestroySemaphore = reinterpret_cast<PFN_vkDestroySemaphore>(gdpa(device, "vkDestroySemaphore"));
   table->DestroyShaderModule = reinterpret_cast<PFN_vkDestroyShaderModule>(gdpa(device, "vkDestroyShaderModule"));
   table->DeviceWaitIdle = reinterpret_cast<PFN_vkDeviceWaitIdle>(gdpa(device, "vkDeviceWaitIdle"));
   table->EndCommandBuffer = reinterpret_cast<PFN_vkEndCommandBuffer>(gdpa(device, "vkEndCommandBuffer"));
@@ -97,7 +99,9 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->GetQueryPoolResults = reinterpret_cast<PFN_vkGetQueryPoolResults>(gdpa(device, "vkGetQueryPoolResults"));
   static constexpr const char* kGetSemaphoreCounterValueNames[] = {"vkGetSemaphoreCounterValue", "vkGetSemaphoreCounterValueKHR"};
   table->GetSemaphoreCounterValue = reinterpret_cast<PFN_vkGetSemaphoreCounterValue>(LoadFirst(gdpa, device, kGetSemaphoreCounterValueNames));
+  table->ImportSemaphoreFdKHR = reinterpret_cast<PFN_vkImportSemaphoreFdKHR>(gdpa(device, "vkImportSemaphoreFdKHR"));
   table->MapMemory = reinterpret_cast<PFN_vkMapMemory>(gdpa(device, "vkMapMemory"));
+  table->QueueBindSparse = reinterpret_cast<PFN_vkQueueBindSparse>(gdpa(device, "vkQueueBindSparse"));
   table->QueueSubmit = reinterpret_cast<PFN_vkQueueSubmit>(gdpa(device, "vkQueueSubmit"));
   static constexpr const char* kQueueSubmit2Names[] = {"vkQueueSubmit2", "vkQueueSubmit2KHR"};
   table->QueueSubmit2 = reinterpret_cast<PFN_vkQueueSubmit2>(LoadFirst(gdpa, device, kQueueSubmit2Names));
@@ -106,6 +110,8 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->ResetCommandPool = reinterpret_cast<PFN_vkResetCommandPool>(gdpa(device, "vkResetCommandPool"));
   table->ResetFences = reinterpret_cast<PFN_vkResetFences>(gdpa(device, "vkResetFences"));
   table->SetDebugUtilsObjectNameEXT = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(gdpa(device, "vkSetDebugUtilsObjectNameEXT"));
+  static constexpr const char* kSignalSemaphoreNames[] = {"vkSignalSemaphore", "vkSignalSemaphoreKHR"};
+  table->SignalSemaphore = reinterpret_cast<PFN_vkSignalSemaphore>(LoadFirst(gdpa, device, kSignalSemaphoreNames));
   table->UnmapMemory = reinterpret_cast<PFN_vkUnmapMemory>(gdpa(device, "vkUnmapMemory"));
   table->WaitForFences = reinterpret_cast<PFN_vkWaitForFences>(gdpa(device, "vkWaitForFences"));
   static constexpr const char* kWaitSemaphoresNames[] = {"vkWaitSemaphores", "vkWaitSemaphoresKHR"};

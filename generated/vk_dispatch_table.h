@@ -52,6 +52,7 @@ struct DeviceDispatchTable {
   PFN_vkCreateFence CreateFence = nullptr;
   PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
+  PFN_vkCreateSemaphore CreateSemaphore = nullptr;
   PFN_vkCreateShaderModule CreateShaderModule = nullptr;
   PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
   PFN_vkDestroyAccelerationStructureKHR DestroyAccelerationStructureKHR = nullptr;
@@ -63,6 +64,7 @@ struct DeviceDispatchTable {
   PFN_vkDestroyPipeline DestroyPipeline = nullptr;
   PFN_vkDestroyPipelineLayout DestroyPipelineLayout = nullptr;
   PFN_vkDestroyQueryPool DestroyQueryPool = nullptr;
+  PFN_vkDestroySemaphore DestroySemaphore = nullptr;
   PFN_vkDestroyShaderModule DestroyShaderModule = nullptr;
   PFN_vkDeviceWaitIdle DeviceWaitIdle = nullptr;
   PFN_vkEndCommandBuffer EndCommandBuffer = nullptr;
@@ -80,7 +82,9 @@ struct DeviceDispatchTable {
   PFN_vkGetFenceStatus GetFenceStatus = nullptr;
   PFN_vkGetQueryPoolResults GetQueryPoolResults = nullptr;
   PFN_vkGetSemaphoreCounterValue GetSemaphoreCounterValue = nullptr;
+  PFN_vkImportSemaphoreFdKHR ImportSemaphoreFdKHR = nullptr;
   PFN_vkMapMemory MapMemory = nullptr;
+  PFN_vkQueueBindSparse QueueBindSparse = nullptr;
   PFN_vkQueueSubmit QueueSubmit = nullptr;
   PFN_vkQueueSubmit2 QueueSubmit2 = nullptr;
   PFN_vkQueueWaitIdle QueueWaitIdle = nullptr;
@@ -88,6 +92,7 @@ struct DeviceDispatchTable {
   PFN_vkResetCommandPool ResetCommandPool = nullptr;
   PFN_vkResetFences ResetFences = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT SetDebugUtilsObjectNameEXT = nullptr;
+  PFN_vkSignalSemaphore SignalSemaphore = nullptr;
   PFN_vkUnmapMemory UnmapMemory = nullptr;
   PFN_vkWaitForFences WaitForFences = nullptr;
   PFN_vkWaitSemaphores WaitSemaphores = nullptr;

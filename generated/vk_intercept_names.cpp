@@ -31,6 +31,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateDevice",
     "vkCreateInstance",
     "vkCreateQueryPool",
+    "vkCreateSemaphore",
     "vkDeferredOperationJoinKHR",
     "vkDestroyAccelerationStructureKHR",
     "vkDestroyBuffer",
@@ -41,6 +42,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyFence",
     "vkDestroyInstance",
     "vkDestroyQueryPool",
+    "vkDestroySemaphore",
     "vkDeviceWaitIdle",
     "vkEndCommandBuffer",
     "vkFreeCommandBuffers",
@@ -52,7 +54,9 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkGetQueryPoolResults",
     "vkGetSemaphoreCounterValue",
     "vkGetSemaphoreCounterValueKHR",
+    "vkImportSemaphoreFdKHR",
     "vkMapMemory",
+    "vkQueueBindSparse",
     "vkQueueSubmit",
     "vkQueueSubmit2",
     "vkQueueSubmit2KHR",
@@ -61,6 +65,8 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkResetCommandPool",
     "vkResetFences",
     "vkSetDebugUtilsObjectNameEXT",
+    "vkSignalSemaphore",
+    "vkSignalSemaphoreKHR",
     "vkUnmapMemory",
     "vkWaitForFences",
     "vkWaitSemaphores",
@@ -94,6 +100,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     false,  // vkCreateDevice
     false,  // vkCreateInstance
     true,  // vkCreateQueryPool
+    true,  // vkCreateSemaphore
     true,  // vkDeferredOperationJoinKHR
     true,  // vkDestroyAccelerationStructureKHR
     true,  // vkDestroyBuffer
@@ -104,6 +111,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkDestroyFence
     false,  // vkDestroyInstance
     true,  // vkDestroyQueryPool
+    true,  // vkDestroySemaphore
     true,  // vkDeviceWaitIdle
     true,  // vkEndCommandBuffer
     true,  // vkFreeCommandBuffers
@@ -115,7 +123,9 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkGetQueryPoolResults
     true,  // vkGetSemaphoreCounterValue
     true,  // vkGetSemaphoreCounterValueKHR
+    true,  // vkImportSemaphoreFdKHR
     true,  // vkMapMemory
+    true,  // vkQueueBindSparse
     true,  // vkQueueSubmit
     true,  // vkQueueSubmit2
     true,  // vkQueueSubmit2KHR
@@ -124,6 +134,8 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkResetCommandPool
     true,  // vkResetFences
     true,  // vkSetDebugUtilsObjectNameEXT
+    true,  // vkSignalSemaphore
+    true,  // vkSignalSemaphoreKHR
     true,  // vkUnmapMemory
     true,  // vkWaitForFences
     true,  // vkWaitSemaphores

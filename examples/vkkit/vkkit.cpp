@@ -1,5 +1,6 @@
 #include "vkkit.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -78,11 +79,13 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptio
       break;
     }
   }
-  const float priority = 1.0f;
+  const uint32_t queue_count =
+      std::max(1u, std::min(options.queue_count, family_count ? families[queue_family_].queueCount : 1u));
+  const std::vector<float> priorities(queue_count, 1.0f);
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   queue_info.queueFamilyIndex = queue_family_;
-  queue_info.queueCount = 1;
-  queue_info.pQueuePriorities = &priority;
+  queue_info.queueCount = queue_count;
+  queue_info.pQueuePriorities = priorities.data();
 
   // rayQuery (or, where the device lacks it, rayTracingPipeline: NVIDIA's driver has no ray queries) is
   // enabled too: the Khronos layer 1.3.239 (stacked below asval in self-validation runs) requires one of
@@ -102,6 +105,7 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptio
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as_features};
   v12.bufferDeviceAddress = VK_TRUE;
   v12.hostQueryReset = VK_TRUE;  // vkResetQueryPool, as programs that compact their structures use it
+  v12.timelineSemaphore = options.timeline_semaphore ? VK_TRUE : VK_FALSE;
   std::vector<const char*> extensions = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
                                          VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
                                          has_ray_query ? VK_KHR_RAY_QUERY_EXTENSION_NAME
@@ -114,6 +118,8 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptio
   info.ppEnabledExtensionNames = extensions.data();
   Check(vkCreateDevice(gpu, &info, nullptr, &device_), "vkCreateDevice");
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  queues_.assign(queue_count, VK_NULL_HANDLE);
+  for (uint32_t i = 0; i < queue_count; ++i) vkGetDeviceQueue(device_, queue_family_, i, &queues_[i]);
   VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pool_info.queueFamilyIndex = queue_family_;

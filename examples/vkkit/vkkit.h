@@ -54,6 +54,8 @@ struct AccelerationStructure {
 struct DeviceOptions {
   std::vector<const char*> extensions;
   void* features = nullptr;  // a chain of feature structures, chained after the Device's own
+  bool timeline_semaphore = false;  // VkPhysicalDeviceVulkan12Features::timelineSemaphore
+  uint32_t queue_count = 1;         // queues of the chosen family, at most what it offers (queue_count())
 };
 
 // Whether the physical device has a device extension.
@@ -68,6 +70,9 @@ class Device {
 
   VkDevice handle() const { return device_; }
   VkQueue queue() const { return queue_; }
+  // Queue i of the chosen family (0: queue()); as many as DeviceOptions::queue_count and the family allow.
+  VkQueue queue(uint32_t i) const { return queues_.at(i); }
+  uint32_t queue_count() const { return static_cast<uint32_t>(queues_.size()); }
   const VkPhysicalDeviceAccelerationStructurePropertiesKHR& as_properties() const { return as_props_; }
 
   // Host-visible, coherent, mapped; usage gets SHADER_DEVICE_ADDRESS added.
@@ -96,6 +101,7 @@ class Device {
   VkPhysicalDevice gpu_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
+  std::vector<VkQueue> queues_;
   uint32_t queue_family_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkPhysicalDeviceMemoryProperties memory_props_{};

@@ -133,63 +133,100 @@ void CaptureTracker::Retire(Pending& p) {
   p.fence = VK_NULL_HANDLE;
 }
 
+namespace {
+
+// The queues a pass over the pending submissions found blocked: one of their submissions is still pending, so the
+// later ones wait (a queue completes in submission order). Fixed size: a pass that meets more queues stops early.
+class BlockedQueues {
+ public:
+  bool Contains(VkQueue queue) const { return std::find(queues_, queues_ + count_, queue) != queues_ + count_; }
+  bool Add(VkQueue queue) {
+    if (count_ == kMax) return false;
+    queues_[count_++] = queue;
+    return true;
+  }
+
+ private:
+  static constexpr std::size_t kMax = 32;
+  VkQueue queues_[kMax] = {};
+  std::size_t count_ = 0;
+};
+
+// A submission whose judgement needs what another still-pending submission fills: an update compared with a source
+// built by an earlier submission on another queue, a deserialization of bytes serialized by one. Filled in this
+// submission itself, they are read in order when it is processed.
+bool NeedsPendingFill(const SubmissionCaptures& c) {
+  for (const ActivityComparison& update : c.comparisons) {
+    if (!update.before || update.before->status() != BuildActivity::Status::kPending) continue;
+    if (std::find(c.fills.begin(), c.fills.end(), update.before) == c.fills.end()) return true;
+  }
+  for (const DeserializeCheck& d : c.deserializes) {
+    if (!d.expected || d.expected->status != SerializedContent::Status::kPending) continue;
+    bool own = false;
+    for (const SerializeCapture& s : c.serializes) own |= s.content == d.expected;
+    if (!own) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 void CaptureTracker::Process(const Covered& covered, const OnComplete& on_complete) {
   if (t_processing) return;
   std::lock_guard<std::recursive_mutex> order(processing_);
   t_processing = true;
-  // On a queue, submissions up to the last one carrying a waited app fence are covered: that fence signaled, so
-  // that submission completed, and the layer's fence of each earlier one on that queue is at most a moment away.
-  // Other queues' submissions are not waited for (they may run long); processing stops at the first of them
-  // still pending, and goes on at the next wait or submission.
-  std::vector<std::pair<VkQueue, std::size_t>> covered_until;  // per queue: entries [0, index) of it are covered
-  try {
+  // Which pending submissions the app's wait covers. On a queue, submissions up to the last one carrying a waited
+  // app fence are covered: that fence signaled, so that submission completed, and the layer's fence of each earlier
+  // one on that queue is at most a moment away. Other queues' submissions are not waited for (they may run long).
+  {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (std::size_t k = 0; k < pending_.size() && covered.fence_count != 0; ++k) {
-      const Pending& p = pending_[k];
-      if (!p.app_fence || std::find(covered.fences, covered.fences + covered.fence_count, p.app_fence) ==
-                              covered.fences + covered.fence_count) {
-        continue;
-      }
-      bool known = false;
-      for (auto& [queue, until] : covered_until) {
-        if (queue == p.queue) until = k + 1, known = true;
-      }
-      if (!known) covered_until.emplace_back(p.queue, k + 1);
+    BlockedQueues fenced;  // queues with a waited app fence at or after the entry (walking backwards)
+    for (std::size_t k = pending_.size(); k-- > 0;) {
+      Pending& p = pending_[k];
+      const bool waited = covered.fence_count != 0 && p.app_fence &&
+                          std::find(covered.fences, covered.fences + covered.fence_count, p.app_fence) !=
+                              covered.fences + covered.fence_count;
+      if (waited && !fenced.Contains(p.queue)) fenced.Add(p.queue);  // full: fewer covered, polled instead
+      p.covered = covered.all || (covered.queue && p.queue == covered.queue) || fenced.Contains(p.queue);
     }
-  } catch (const std::bad_alloc&) {
-    // The app's fences then cover nothing here: what completed is still processed (its own or the layer's fence
-    // polled), the rest at the next wait, submission or vkDestroyDevice.
-    covered_until.clear();
   }
-  const auto fence_covers = [&](const Pending& p, std::size_t k) {
-    for (const auto& [queue, until] : covered_until) {
-      if (queue == p.queue && k < until) return true;
-    }
-    return false;
-  };
-  for (std::size_t k = 0;; ++k) {
+  // Completed submissions are processed in submission order per queue: a queue's pending submission holds back the
+  // later ones on that queue only (and those that need what it fills), not other queues' completed work.
+  BlockedQueues blocked;
+  std::size_t k = 0;
+  for (;;) {
     Pending current;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (pending_.empty()) break;
-      Pending& p = pending_.front();
-      // The app's wait covers it: its queue or device went idle, or a fence signaled whose first scope holds it
-      // (a fence signal covers every earlier submission to its queue).
-      const bool covered_here = covered.all || (covered.queue && p.queue == covered.queue) || fence_covers(p, k);
-      bool done = p.complete;
-      if (!done && p.fence) {
-        VkResult status = next_.GetFenceStatus(device_, p.fence);
-        if (status == VK_NOT_READY && covered_here) {
-          status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
+      bool found = false;
+      for (; k < pending_.size(); ++k) {
+        Pending& p = pending_[k];
+        if (blocked.Contains(p.queue)) continue;
+        bool done = false;
+        if (covered.all || !NeedsPendingFill(p.captures)) {
+          done = p.complete;
+          if (!done && p.fence) {
+            VkResult status = next_.GetFenceStatus(device_, p.fence);
+            if (status == VK_NOT_READY && p.covered) {
+              status = next_.WaitForFences(device_, 1, &p.fence, VK_TRUE, kCoveredWaitNs);
+            }
+            done = status == VK_SUCCESS;
+          } else if (!done) {
+            // The app's fence is alive while it names the submission (FenceRetired): polling it is safe.
+            done = p.covered || (p.app_fence && next_.GetFenceStatus(device_, p.app_fence) == VK_SUCCESS);
+          }
         }
-        done = status == VK_SUCCESS;
-      } else if (!done) {
-        // The app's fence is alive while it names the submission (FenceRetired): polling it is safe.
-        done = covered_here || (p.app_fence && next_.GetFenceStatus(device_, p.app_fence) == VK_SUCCESS);
+        if (!done) {
+          // Still pending (or the device was lost): later, in order. Too many queues to remember: stop here.
+          if (!blocked.Add(p.queue)) k = pending_.size();
+          continue;
+        }
+        current = std::move(p);
+        pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
+        found = true;
+        break;
       }
-      if (!done) break;  // still pending (or the device was lost): later, in order
-      current = std::move(p);
-      pending_.pop_front();
+      if (!found) break;
     }
     try {
       on_complete(current.captures);
@@ -209,6 +246,5 @@ void CaptureTracker::Process(const Covered& covered, const OnComplete& on_comple
   }
   t_processing = false;
 }
-
 
 }  // namespace asval

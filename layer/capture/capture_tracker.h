@@ -3,8 +3,10 @@
 // own fence is complete once that fence is seen signaled (polled through the next element, or waited for by the
 // app), or reset or destroyed by the app (both require the submission to have completed), or its queue or
 // device waited idle. A submission without a fence gets one of the layer's, passed down in place of the app's
-// VK_NULL_HANDLE (the app's submission is otherwise unchanged and cannot observe it). Completed submissions are processed in submission order (their captured
-// builds' activity filled, then the update rules run on it) when the app learns of completion: in the wait
+// VK_NULL_HANDLE (the app's submission is otherwise unchanged and cannot observe it). Completed submissions are
+// processed in submission order per queue (their captured builds' activity filled, then the update rules run on
+// it; one queue's pending submission does not hold back another queue's completed ones, except one that needs what
+// the pending one fills) when the app learns of completion: in the wait
 // hooks (after the app's wait returned, waiting for the layer's fence of each submission the app's wait covers:
 // the work is done, so that fence signals at once), at the next submission when already complete, and at
 // vkDestroyDevice. Findings are therefore reported before the app's wait returns.
@@ -57,9 +59,9 @@ class CaptureTracker {
   // vkResetFences / vkDestroyFence of an app's fence: the submissions it was given to completed (the app may
   // reset or destroy a fence only then), and the handle no longer names them.
   void FenceRetired(VkFence app_fence);
-  // Processes, in submission order, every submission that completed, and those `covered` names (waiting for
-  // their layer fence); stops at the first one still pending. A call made while this thread is processing (from
-  // an app callback) does nothing.
+  // Processes, in submission order per queue, every submission that completed, and those `covered` names (waiting
+  // for their layer fence); on each queue, stops at the first one still pending. A call made while this thread is
+  // processing (from an app callback) does nothing.
   void Process(const Covered& covered, const OnComplete& on_complete);
   // Adds its pending submissions and spare fences to the layer's footprint (footprint.h).
   void AddFootprint(CaptureFootprint* out) const;
@@ -72,6 +74,7 @@ class CaptureTracker {
     VkFence app_fence = VK_NULL_HANDLE;  // the app's fence, while it names this submission
     VkFence fence = VK_NULL_HANDLE;      // the layer's own, when the app gave none
     bool complete = false;               // known complete (its app fence was reset or destroyed)
+    bool covered = false;                // the app's wait being processed covers it (Process)
     SubmissionCaptures captures;
   };
   void Retire(Pending& p);

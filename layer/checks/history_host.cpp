@@ -108,6 +108,23 @@ void ReportFailureSummary(const DeviceState& state, Reporter& reporter, VkDevice
                   reports_lost));
 }
 
+// Execution order across queues (submission_order.h): said only when a batch had to wait or could not be ordered.
+void ReportOrderSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const OrderCounters& c = state.history.order.counters;
+  const auto n = [](const std::atomic<uint64_t>& counter) { return counter.load(std::memory_order_relaxed); };
+  if (n(c.batches_deferred) == 0 && n(c.batches_unordered) == 0 && n(c.batches_never_resolved) == 0) return;
+  reporter.Report(
+      Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("Execution order across queues: {} submitted batches waited for a timeline semaphore value not yet "
+                  "signaled (or came after one on their queue) and were applied and checked when it was signaled "
+                  "(their captures were not read); {} batches waited on a semaphore shared outside the layer's view "
+                  "for a value it had not seen signaled, or could not be kept: their {} operations were not checked "
+                  "and every structure's history was made unknown; {} batches were still waiting at vkDestroyDevice "
+                  "and were never applied. Skipped and counted, never guessed.",
+                  n(c.batches_deferred), n(c.batches_unordered), n(c.operations_unordered),
+                  n(c.batches_never_resolved)));
+}
+
 }  // namespace
 
 void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
@@ -150,6 +167,7 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
                                 "it could not capture): skipped, never guessed.",
                                 unknown));
   }
+  ReportOrderSummary(state, reporter, device);
   if (skipped == 0) return;
   reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                   {Obj(VK_OBJECT_TYPE_DEVICE, device)},

@@ -60,7 +60,17 @@ void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQ
                   kSubmissionNotPassedDown, Cause(cause.vuid(), cause.where())));
 }
 
-void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause) {
+void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause, bool deferred) {
+  if (deferred) {
+    ctx.reporter.ReportLayerAction(
+        kProtectWithheldId, Location(cause.function()), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+        fmt::format("protect: asval reported {} when it judged a batch that waited for a timeline semaphore value "
+                    "signaled only later (execution order across queues): that batch had been passed down when it "
+                    "was submitted, and what it builds may be corrupt. Every later submission on this device is "
+                    "withheld (VK_ERROR_VALIDATION_FAILED_EXT), so that nothing uses it.",
+                    Cause(cause.vuid(), cause.where())));
+    return;
+  }
   ctx.reporter.ReportLayerAction(
       kProtectWithheldId, Location(cause.function()), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
       fmt::format("protect: asval reported {} when the work that broke the rule completed (execution-time "

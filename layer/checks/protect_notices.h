@@ -28,7 +28,8 @@ void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, V
 void ReportWithheldSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
                               const ProtectScope& cause);
 // An error judged at completion (execution-time capture) halted submissions: every later one is withheld.
-void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause);
+// `deferred`: found when a batch deferred until its semaphore wait was signaled was judged (submission_order.h).
+void ReportSubmissionHalt(const CheckContext& ctx, VkDevice device, const ProtectScope& cause, bool deferred = false);
 // A submission not passed down because submissions are halted (SubmissionHalt, protect_marks.h).
 void ReportHaltedSubmission(const CheckContext& ctx, const char* function, VkQueue queue,
                             const WithheldCommand& cause);

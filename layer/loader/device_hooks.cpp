@@ -1,5 +1,7 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include <mutex>
+
 #include "capture_usage.h"
 #include "footprint_report.h"
 #include "history_host.h"
@@ -26,6 +28,11 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
   }
   if (data && data->capture_aliases) data->capture_aliases->Shutdown();  // the layer's buffers over app memory
   if (data) {
+    {
+      // Batches still waiting for a semaphore value nobody signaled (the device is idle: they never ran).
+      std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
+      data->state.history.order.NeverResolved();
+    }
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
   }

@@ -4,7 +4,13 @@
 // returns VK_TRUE keeps the whole submission from the driver, as the Khronos layer does, and its history
 // changes are undone; so are those of a submission the driver rejects. In protect mode (withhold.h) so does any
 // error found at submission, and a submitted command buffer that lacks a command the layer withheld.
+// Batches are applied in an order the device can execute them in (layer/state/submission_order.h): one that waits
+// for a timeline value nothing has signaled yet is deferred until a later call signals it (ordered_batches.h).
+#include <mutex>
+#include <optional>
+
 #include "layer_data.h"
+#include "ordered_batches.h"
 #include "submission.h"
 #include "submit_checks.h"
 #include "vk_intercepts.h"
@@ -14,21 +20,63 @@ namespace asval::hooks {
 
 namespace {
 
-// for_each_command_buffer(visit) calls visit(cb, location) for every submitted command buffer, in order.
-template <typename ForEachCommandBuffer, typename Downcall>
-VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence fence,
-                ForEachCommandBuffer&& for_each_command_buffer, Downcall&& downcall) {
+// The capture logs a deferred (or unordered) command buffer's copies write, counted pending with the call's captures
+// so that another submission of the same recording is not read while the device may write them (capture_tracker.h).
+void HoldDeferredLogs(const RecordedOps& ops, SubmissionCaptures& captures) {
+  for (const std::shared_ptr<CaptureLog>& log : ops.capture_logs) {
+    bool known = false;
+    for (const std::shared_ptr<CaptureLog>& held : captures.logs) known |= held == log;
+    if (!known) captures.logs.push_back(log);
+  }
+}
+
+// semaphores_of(i): batch i's BatchSemaphores; for_each_command_buffer_in(i, visit) calls visit(cb, location, j)
+// for every command buffer of batch i, in order. has_semaphores(): some batch waits or signals.
+template <typename HasSemaphores, typename SemaphoresOf, typename ForEachCommandBufferIn, typename Downcall>
+VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence fence, uint32_t batch_count,
+                HasSemaphores&& has_semaphores, SemaphoresOf&& semaphores_of,
+                ForEachCommandBufferIn&& for_each_command_buffer_in, Downcall&& downcall) {
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
+  const auto for_each_command_buffer = [&](auto&& visit) {
+    for (uint32_t i = 0; i < batch_count; ++i) {
+      for_each_command_buffer_in(i, [&](VkCommandBuffer cb, const Location& loc, uint32_t) { visit(cb, loc); });
+    }
+  };
   if (data.reporter->protects() && WithholdSubmission(data, function, queue, for_each_command_buffer)) {
     return VK_ERROR_VALIDATION_FAILED_EXT;
   }
   const CheckContext ctx = MakeCheckContext(data);
+  // Execution order across queues: only a device with timeline semaphores, or with batches deferred, pays for it.
+  SubmissionOrder& order = data.state.history.order;
+  std::unique_lock<std::recursive_mutex> order_lock;  // declared before the submission: released after it
+  std::optional<SubmissionOrder::Call> call;
+  if (data.state.history_tracked && (order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
+    order_lock = std::unique_lock<std::recursive_mutex>(data.state.history.submission_order);
+    call.emplace(order, queue, function);
+  }
   HistorySubmission submission(data.state);
   SubmitChecks checks(ctx);
-  for_each_command_buffer(
-      [&](VkCommandBuffer cb, const Location& loc) { submission.Apply(cb, checks.For(cb, loc)); });
+  uint64_t unordered_batches = 0, unordered_ops = 0;
+  for (uint32_t i = 0; i < batch_count; ++i) {
+    const Placement place = call ? call->Place(semaphores_of(i)) : Placement::kNow;
+    unordered_batches += place == Placement::kUnordered;
+    for_each_command_buffer_in(i, [&](VkCommandBuffer cb, const Location& loc, uint32_t j) {
+      if (place == Placement::kNow) return submission.Apply(cb, checks.For(cb, loc));
+      std::shared_ptr<const RecordedOps> ops;
+      if (!RecordedOf(data.state, cb, &ops)) return;
+      if (place == Placement::kUnordered) unordered_ops += submission.ApplyUnordered(ops);
+      if (place == Placement::kDeferred) call->Defer(cb, i, j, ops);
+      if (ops && data.capture_tracker) {
+        try {
+          HoldDeferredLogs(*ops, submission.captures());
+        } catch (const std::bad_alloc&) {
+          data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
+    });
+  }
   submission.EndApply();
   const ProtectScope protect(data.reporter->protects());
   if (checks.ReportAll()) {
@@ -41,7 +89,8 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   }
   // Pre-record: the recordings whose captures run now count as pending before the device may write them.
   // Without a fence of the app's, the layer's own goes down in its place and tells when the bytes are there.
-  const bool captures = data.capture_tracker && !submission.captures().empty();
+  const SubmissionCaptures& held = submission.captures();
+  const bool captures = data.capture_tracker && (!held.empty() || !held.logs.empty());
   VkFence layer_fence = VK_NULL_HANDLE;
   if (captures) {
     data.capture_tracker->Reserve(submission.captures());
@@ -54,8 +103,15 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
       data.capture_tracker->ReturnFence(layer_fence);
     }
     submission.Undo();
-  } else if (captures) {
-    data.capture_tracker->Track(queue, fence, layer_fence, std::move(submission.captures()));
+    return result;  // the call's deferred batches are forgotten, its signals undone (~Call)
+  }
+  if (captures) data.capture_tracker->Track(queue, fence, layer_fence, std::move(submission.captures()));
+  if (call) {
+    call->Commit();
+    order.counters.batches_unordered.fetch_add(unordered_batches, std::memory_order_relaxed);
+    order.counters.operations_unordered.fetch_add(unordered_ops, std::memory_order_relaxed);
+    // What this call signaled may let deferred batches run: they execute after it, so they are applied after it.
+    ApplyReadyBatches(data);
   }
   return result;
 }
@@ -65,14 +121,19 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
 VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, const VkSubmitInfo* pSubmits,
                                            VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
+  const Location root("vkQueueSubmit");
   return Submit(
-      *data, "vkQueueSubmit", queue, fence,
-      [&](auto&& visit) {
-        const Location root("vkQueueSubmit");
+      *data, "vkQueueSubmit", queue, fence, submitCount,
+      [&] {
         for (uint32_t i = 0; i < submitCount; ++i) {
-          for (uint32_t j = 0; j < pSubmits[i].commandBufferCount; ++j) {
-            visit(pSubmits[i].pCommandBuffers[j], root.Field("pSubmits", i).Field("pCommandBuffers", j));
-          }
+          if (pSubmits[i].waitSemaphoreCount != 0 || pSubmits[i].signalSemaphoreCount != 0) return true;
+        }
+        return false;
+      },
+      [&](uint32_t i) { return SemaphoresOf(pSubmits[i]); },
+      [&](uint32_t i, auto&& visit) {
+        for (uint32_t j = 0; j < pSubmits[i].commandBufferCount; ++j) {
+          visit(pSubmits[i].pCommandBuffers[j], root.Field("pSubmits", i).Field("pCommandBuffers", j), j);
         }
       },
       [&](VkFence down_fence) { return data->dispatch.QueueSubmit(queue, submitCount, pSubmits, down_fence); });
@@ -82,18 +143,49 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, 
 VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t submitCount, const VkSubmitInfo2* pSubmits,
                                             VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
+  const Location root("vkQueueSubmit2");
   return Submit(
-      *data, "vkQueueSubmit2", queue, fence,
-      [&](auto&& visit) {
-        const Location root("vkQueueSubmit2");
+      *data, "vkQueueSubmit2", queue, fence, submitCount,
+      [&] {
         for (uint32_t i = 0; i < submitCount; ++i) {
-          for (uint32_t j = 0; j < pSubmits[i].commandBufferInfoCount; ++j) {
-            visit(pSubmits[i].pCommandBufferInfos[j].commandBuffer,
-                  root.Field("pSubmits", i).Field("pCommandBufferInfos", j).Field("commandBuffer"));
-          }
+          if (pSubmits[i].waitSemaphoreInfoCount != 0 || pSubmits[i].signalSemaphoreInfoCount != 0) return true;
+        }
+        return false;
+      },
+      [&](uint32_t i) { return SemaphoresOf(pSubmits[i]); },
+      [&](uint32_t i, auto&& visit) {
+        for (uint32_t j = 0; j < pSubmits[i].commandBufferInfoCount; ++j) {
+          visit(pSubmits[i].pCommandBufferInfos[j].commandBuffer,
+                root.Field("pSubmits", i).Field("pCommandBufferInfos", j).Field("commandBuffer"), j);
         }
       },
       [&](VkFence down_fence) { return data->dispatch.QueueSubmit2(queue, submitCount, pSubmits, down_fence); });
+}
+
+// Sparse binding touches no structure's history, but its semaphores order the batches that do: a bind that waits
+// for an unsignaled value holds back what it signals, and the values it signals may let deferred batches run.
+VKAPI_ATTR VkResult VKAPI_CALL QueueBindSparse(VkQueue queue, uint32_t bindInfoCount, const VkBindSparseInfo* pBindInfo,
+                                               VkFence fence) {
+  DeviceData* data = GetDeviceData(queue);
+  SubmissionOrder& order = data->state.history.order;
+  const auto has_semaphores = [&] {
+    for (uint32_t i = 0; i < bindInfoCount; ++i) {
+      if (pBindInfo[i].waitSemaphoreCount != 0 || pBindInfo[i].signalSemaphoreCount != 0) return true;
+    }
+    return false;
+  };
+  if (!data->state.history_tracked || !(order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
+    return data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence);
+  }
+  std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
+  SubmissionOrder::Call call(order, queue, "vkQueueBindSparse");
+  for (uint32_t i = 0; i < bindInfoCount; ++i) call.Place(SemaphoresOf(pBindInfo[i]));
+  const VkResult result = data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence);
+  if (result == VK_SUCCESS) {
+    call.Commit();
+    ApplyReadyBatches(*data);
+  }
+  return result;
 }
 
 }  // namespace asval::hooks

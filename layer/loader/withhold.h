@@ -53,10 +53,11 @@ bool WithholdSubmission(DeviceData& data, const char* function, VkQueue queue,
 
 // Errors judged at completion (execution-time capture) while `protect` was open: the work already ran, so every
 // later submission on the device is withheld (named once here, and in each submission's notice).
-inline void HaltSubmissionsAfter(DeviceData& data, const ProtectScope& protect) {
+// `deferred`: errors of a batch judged when its semaphore wait was signaled, after it went down (ordered_batches.h).
+inline void HaltSubmissionsAfter(DeviceData& data, const ProtectScope& protect, bool deferred = false) {
   if (!protect.withheld() || data.state.protect_halt.Cause()) return;
   RecordSubmissionHalt(data.state, protect.function(), protect.vuid(), protect.where());
-  ReportSubmissionHalt(MakeCheckContext(data), data.device, protect);
+  ReportSubmissionHalt(MakeCheckContext(data), data.device, protect, deferred);
 }
 
 }  // namespace asval::hooks

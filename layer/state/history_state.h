@@ -13,6 +13,7 @@
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
 #include "history.h"
+#include "submission_order.h"
 
 namespace asval {
 
@@ -34,6 +35,8 @@ struct HistoryState {
   // checked against changes of a submission that did not happen. Recursive: an app callback that reports a
   // finding of the submission may itself submit on this thread. Taken before store's lock, never after.
   std::recursive_mutex submission_order;
+  // Which submitted batches the device can have run, by their semaphores (guarded by submission_order).
+  SubmissionOrder order;
   ConcurrentMap<VkQueryPool, QueryPoolState> query_pools;
 
   // Deferred host operations (vkBuildAccelerationStructuresKHR and the host copies with a deferredOperation

@@ -2,8 +2,8 @@
 
 namespace asval {
 
-bool HistorySubmission::Lookup(VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) const {
-  const std::shared_ptr<CommandBufferState> record = state_.command_buffers.Find(cb);
+bool RecordedOf(const DeviceState& state, VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) {
+  const std::shared_ptr<CommandBufferState> record = state.command_buffers.Find(cb);
   if (!record) return true;  // never seen allocated: unknown
   *ops = record->Executable();
   return *ops != nullptr;
@@ -42,6 +42,18 @@ void HistorySubmission::ApplyFailed(std::size_t unchecked) {
   if (!order_lock_.owns_lock()) order_lock_ = std::unique_lock<std::recursive_mutex>(state_.history.submission_order);
   if (!store_lock_.owns_lock()) store_lock_ = state_.history.store.Lock();
   MakeAllUnknownAfterFailure(state_, state_.history.store);
+}
+
+std::size_t HistorySubmission::ApplyUnordered(const std::shared_ptr<const RecordedOps>& ops) {
+  if (!state_.history_tracked) return 0;
+  const std::size_t unchecked = ops && !ops->lost ? ops->batch.ops().size() : 0;
+  try {
+    Begin();
+    ApplyUnknownCommandBuffer(state_, state_.history.store, txn_.get());
+  } catch (const std::bad_alloc&) {
+    ApplyFailed(0);
+  }
+  return unchecked;
 }
 
 void HistorySubmission::Undo() {

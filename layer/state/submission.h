@@ -28,6 +28,10 @@
 
 namespace asval {
 
+// False when the command buffer does nothing to structures; *ops null when what it does is unknown (a command
+// buffer the layer never saw allocated).
+bool RecordedOf(const DeviceState& state, VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops);
+
 class HistorySubmission {
  public:
   explicit HistorySubmission(DeviceState& state) : state_(state) { captures_.failures = &state.failures(); }
@@ -44,7 +48,14 @@ class HistorySubmission {
   void Apply(VkCommandBuffer cb, Check&& check) {
     if (!state_.history_tracked) return;
     std::shared_ptr<const RecordedOps> ops;
-    if (!Lookup(cb, &ops)) return;  // most submitted command buffers build nothing: no lock
+    if (!RecordedOf(state_, cb, &ops)) return;  // most submitted command buffers build nothing: no lock
+    ApplyRecorded(ops, check);
+  }
+  // The same for operations read earlier (RecordedOf; null: unknown), e.g. a batch deferred until the semaphore
+  // it waits for is signaled (submission_order.h).
+  template <typename Check>
+  void ApplyRecorded(const std::shared_ptr<const RecordedOps>& ops, Check&& check) {
+    if (!state_.history_tracked) return;
     std::size_t total = 0, checked = 0, applied = 0;
     try {
       Begin();
@@ -57,10 +68,11 @@ class HistorySubmission {
       const OpBatch& batch = ops->batch;
       total = batch.ops().size();
       txn_->ReserveMore(total);  // one entry per written structure (clobbers are rare)
+      SubmissionCaptures* captures = read_captures_ ? &captures_ : nullptr;
       for (const AsOp& op : batch.ops()) {
         check(static_cast<const HistoryStore&>(store), batch, op);
         ++checked;
-        ApplyOp(state_, store, batch, op, txn_.get(), &captures_);
+        ApplyOp(state_, store, batch, op, txn_.get(), captures);
         ++applied;
       }
     } catch (const std::bad_alloc&) {
@@ -69,6 +81,12 @@ class HistorySubmission {
     ops_applied_ += applied;
     state_.history.store.ops_applied.fetch_add(applied, std::memory_order_relaxed);
   }
+  // A batch whose place in execution order the layer cannot know (submission_order.h, kUnordered): every
+  // structure's history becomes unknown, and its operations are not checked (returned: their count).
+  std::size_t ApplyUnordered(const std::shared_ptr<const RecordedOps>& ops);
+  // Applies without reading captures: the builds' activity stays unknown (a deferred batch went down before the
+  // layer knew what it would capture, so its captures were not reserved: capture_tracker.h).
+  void WithoutCaptures() { read_captures_ = false; }
   // Releases the store's lock (the order lock stays held until destruction).
   void EndApply() {
     if (store_lock_.owns_lock()) store_lock_.unlock();
@@ -81,8 +99,6 @@ class HistorySubmission {
   SubmissionCaptures& captures() { return captures_; }
 
  private:
-  // False when the command buffer does nothing to structures; *ops null when what it does is unknown.
-  bool Lookup(VkCommandBuffer cb, std::shared_ptr<const RecordedOps>* ops) const;
   void Begin();
   // An allocation failed while applying: every structure unknown from here on, counted.
   void ApplyFailed(std::size_t unchecked);
@@ -95,6 +111,7 @@ class HistorySubmission {
   std::unique_ptr<Transaction> txn_;
   SubmissionCaptures captures_;
   uint64_t ops_applied_ = 0;
+  bool read_captures_ = true;
 };
 
 }  // namespace asval

@@ -20,10 +20,11 @@ constexpr VkBufferUsageFlags kInputUsage = VK_BUFFER_USAGE_ACCELERATION_STRUCTUR
 
 }  // namespace
 
-HistoryFixture::HistoryFixture(const char* families, const std::vector<std::pair<const char*, const char*>>& settings) {
+HistoryFixture::HistoryFixture(const char* families, const std::vector<std::pair<const char*, const char*>>& settings,
+                               const vkkit::DeviceOptions& device) {
   if (families) settings_.Add("enabled_checks", families);
   for (const auto& [name, value] : settings) settings_.Add(name, value);
-  fixture_ = std::make_unique<Fixture>(settings_.settings.empty() ? nullptr : settings_.Chain());
+  fixture_ = std::make_unique<Fixture>(settings_.settings.empty() ? nullptr : settings_.Chain(), device);
 }
 
 Procs::Procs(vkkit::Device& device) {

@@ -17,7 +17,8 @@ namespace asval_test {
 class HistoryFixture {
  public:
   explicit HistoryFixture(const char* families = nullptr,
-                          const std::vector<std::pair<const char*, const char*>>& settings = {});
+                          const std::vector<std::pair<const char*, const char*>>& settings = {},
+                          const vkkit::DeviceOptions& device = {});
   Monitor& monitor() { return fixture_->monitor(); }
   vkkit::Instance& instance() { return fixture_->instance(); }
   vkkit::Device& device() { return fixture_->device(); }

@@ -1,0 +1,207 @@
+// Execution order follows the semaphores (issue 25, item 8). A submission that waits for a timeline value nothing
+// has signaled yet runs after whatever signals it: the layer applies and judges it then, not in host order.
+//
+// Lavapipe offers one queue. On one queue the device runs batches in submission order, so what one queue can show
+// is the deferral itself: a batch that waits for a value the host signals later (valid: vkSignalSemaphore from the
+// host) is judged when the host signals it, not when it is submitted; and in protect mode an error found then halts
+// later submissions, because the batch went down already. Two queues with a wait-before-signal across them (the
+// case that gave false positives) run where the device offers two queues (the NVIDIA H200) and skip on lavapipe;
+// tests/unit/queue_order_unit_test.cpp runs the same over two fake queues everywhere.
+#include <catch2/catch_test_macros.hpp>
+
+#include "history_helpers.h"
+
+namespace asval_test {
+namespace {
+
+constexpr const char* k03762 = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03762";
+
+vkkit::DeviceOptions TimelineDevice(uint32_t queues = 1) {
+  vkkit::DeviceOptions options;
+  options.timeline_semaphore = true;
+  options.queue_count = queues;
+  return options;
+}
+
+// Geometry flags are among what an update must repeat (03762), and a mismatch is harmless to the driver that
+// executes it (the firing tests' updates go down: a deferred batch was submitted before it could be judged).
+Shape Flags(VkGeometryFlagsKHR flags) {
+  Shape s;
+  s.geometry_flags = flags;
+  return s;
+}
+const Shape kOpaque = Flags(VK_GEOMETRY_OPAQUE_BIT_KHR);
+const Shape kNoDuplicate = Flags(VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR);
+
+class Timeline {
+ public:
+  explicit Timeline(vkkit::Device& device) : device_(device) {
+    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE,
+                                   0};
+    const VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+    vkkit::Check(vkCreateSemaphore(device.handle(), &info, nullptr, &semaphore_), "vkCreateSemaphore");
+  }
+  ~Timeline() { vkDestroySemaphore(device_.handle(), semaphore_, nullptr); }
+  VkSemaphore handle() const { return semaphore_; }
+  VkResult HostSignal(uint64_t value) {
+    const VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO, nullptr, semaphore_, value};
+    return vkSignalSemaphore(device_.handle(), &info);
+  }
+
+ private:
+  vkkit::Device& device_;
+  VkSemaphore semaphore_ = VK_NULL_HANDLE;
+};
+
+// Submits cb on `queue`, waiting for timeline >= wait (0: no wait) and signaling `signal` (0: none); no fence.
+VkResult SubmitOn(VkQueue queue, VkCommandBuffer cb, const Timeline& timeline, uint64_t wait, uint64_t signal) {
+  const VkSemaphore semaphore = timeline.handle();
+  const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+  VkTimelineSemaphoreSubmitInfo values{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  values.waitSemaphoreValueCount = wait ? 1 : 0;
+  values.pWaitSemaphoreValues = &wait;
+  values.signalSemaphoreValueCount = signal ? 1 : 0;
+  values.pSignalSemaphoreValues = &signal;
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO, &values};
+  submit.waitSemaphoreCount = wait ? 1 : 0;
+  submit.pWaitSemaphores = &semaphore;
+  submit.pWaitDstStageMask = &stage;
+  submit.signalSemaphoreCount = signal ? 1 : 0;
+  submit.pSignalSemaphores = &semaphore;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  return vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE);
+}
+
+VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBuffer cb = commands.Begin();
+  record(cb);
+  commands.End(cb);
+  return cb;
+}
+
+TEST_CASE("order: an update waiting for a value the host signals later is judged when the host signals it (03762)",
+          "[integration][history][order][passes-invalid-down]") {
+  HistoryFixture f("history", {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); });
+  // Waits for 1, which nothing has signaled: not judged yet (before the fix: 03762 here, at vkQueueSubmit).
+  CHECK(SubmitOn(device.queue(), update, timeline, 1, 0) == VK_SUCCESS);
+  CHECK(f.monitor().Take().empty());
+  REQUIRE(timeline.HostSignal(1) == VK_SUCCESS);
+  const std::vector<Message> messages = f.monitor().Take();
+  REQUIRE(messages.size() == 1);
+  CHECK(messages[0].id_name == k03762);
+  CHECK(messages[0].text.find("vkQueueSubmit(): pSubmits[0].pCommandBuffers[0]") != std::string::npos);
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+}
+
+TEST_CASE("order valid twin: a batch waiting for the host, and a later one on its queue, applied in queue order",
+          "[integration][history][order]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kOpaque); });
+  const VkCommandBuffer rebuild = Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kNoDuplicate); });
+  REQUIRE(SubmitOn(device.queue(), update, timeline, 1, 2) == VK_SUCCESS);
+  REQUIRE(SubmitOn(device.queue(), rebuild, timeline, 0, 0) == VK_SUCCESS);  // runs after the update: its queue
+  REQUIRE(timeline.HostSignal(1) == VK_SUCCESS);
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+  // The rebuild ran last: an update repeating it is valid.
+  CHECK(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); })) ==
+        VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("order: protect mode halts later submissions after an error found when a deferred batch is judged",
+          "[integration][history][order][protect][passes-invalid-down]") {
+  HistoryFixture f("history", {{"protect", "true"}}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); });
+  CHECK(SubmitOn(device.queue(), update, timeline, 1, 0) == VK_SUCCESS);  // went down before it could be judged
+  f.monitor().Expect(k03762);
+  REQUIRE(timeline.HostSignal(1) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+  // Whatever the invalid update left is not traced: every later submission is withheld.
+  CHECK(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) ==
+        VK_ERROR_VALIDATION_FAILED_EXT);
+}
+
+TEST_CASE("order valid twin: protect mode lets a valid deferred batch and what follows through",
+          "[integration][history][order][protect]") {
+  HistoryFixture f(nullptr, {{"protect", "true"}}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kOpaque); });
+  CHECK(SubmitOn(device.queue(), update, timeline, 1, 0) == VK_SUCCESS);
+  REQUIRE(timeline.HostSignal(1) == VK_SUCCESS);
+  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+  CHECK(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kOpaque); })) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
+// Two queues: queue 0's update waits for a value queue 1 signals after its rebuild, submitted later. The device
+// runs the rebuild first. Where the device has one queue (lavapipe) this skips: see the unit test.
+TEST_CASE("order valid twin: an update waiting for another queue's later rebuild is judged against that rebuild",
+          "[integration][history][order][two-queues]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice(2));
+  vkkit::Device& device = f.device();
+  if (device.queue_count() < 2) SKIP("the device offers one queue in its compute family");
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); });
+  const VkCommandBuffer rebuild = Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kNoDuplicate); });
+  REQUIRE(SubmitOn(device.queue(0), update, timeline, 1, 0) == VK_SUCCESS);  // before the fix: 03762 here
+  REQUIRE(SubmitOn(device.queue(1), rebuild, timeline, 0, 1) == VK_SUCCESS);
+  vkkit::Check(vkQueueWaitIdle(device.queue(0)), "vkQueueWaitIdle");
+  vkkit::Check(vkQueueWaitIdle(device.queue(1)), "vkQueueWaitIdle");
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("order: an update contradicting another queue's later rebuild that runs before it is reported (03762)",
+          "[integration][history][order][two-queues][passes-invalid-down]") {
+  HistoryFixture f("history", {}, TimelineDevice(2));
+  vkkit::Device& device = f.device();
+  if (device.queue_count() < 2) SKIP("the device offers one queue in its compute family");
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kNoDuplicate); })) ==
+          VK_SUCCESS);
+  const VkCommandBuffer update = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); });
+  const VkCommandBuffer rebuild = Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); });
+  REQUIRE(SubmitOn(device.queue(0), update, timeline, 1, 0) == VK_SUCCESS);  // before the fix: silent
+  CHECK(f.monitor().Take().empty());
+  f.monitor().Expect(k03762);
+  // Reported when the rebuild that runs before it is submitted; both went down (the rebuild is valid itself).
+  CHECK(SubmitOn(device.queue(1), rebuild, timeline, 0, 1) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+  vkkit::Check(vkQueueWaitIdle(device.queue(0)), "vkQueueWaitIdle");
+  vkkit::Check(vkQueueWaitIdle(device.queue(1)), "vkQueueWaitIdle");
+}
+
+}  // namespace
+}  // namespace asval_test
