@@ -257,5 +257,29 @@ TEST_CASE("protect: another queue waiting for a withheld submission's timeline v
   CHECK(f.monitor().Verify() == "");
 }
 
+// Run only by tests/gate/withheld_waits_test.py, under scripts/asval-run (protect on from its environment): an app
+// that ignores the withheld submission's error and waits without a timeout for its fence, for its binary semaphore
+// through a next submission, for its timeline value on the host, then for the device to go idle. Before issue 26 it
+// never returned; the gate must end it with exit 65 within the test's time.
+TEST_CASE("protect child: waits without a timeout on a withheld submission", "[.][withheld-waits-child]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline timeline(device);
+  BinarySemaphore binary(device);
+  Fence withheld_fence(device), next_fence(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer cb) { blas.Build(cb, kOpaque); })) == VK_SUCCESS);
+  const VkCommandBuffer invalid = Recorded(commands, [&](VkCommandBuffer cb) { blas.Update(cb, kNoDuplicate); });
+  (void)SubmitSignaling(device.queue(), invalid, &binary, timeline, 1, withheld_fence);  // the result is ignored
+  const VkCommandBuffer next = Recorded(commands, [&](VkCommandBuffer) {});
+  (void)SubmitWaiting(device.queue(), next, binary, next_fence);
+  const VkFence fences[2] = {withheld_fence.handle(), next_fence.handle()};
+  vkkit::Check(vkWaitForFences(device.handle(), 2, fences, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  vkkit::Check(timeline.HostWait(1, UINT64_MAX), "vkWaitSemaphores");
+  vkkit::Check(vkDeviceWaitIdle(device.handle()), "vkDeviceWaitIdle");
+}
+
 }  // namespace
 }  // namespace asval_test

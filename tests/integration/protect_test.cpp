@@ -128,9 +128,10 @@ class NoticeListener {
 class ProtectRun {
  public:
   explicit ProtectRun(const char* families = nullptr, bool protect = true, const std::string& report = "",
-                      bool settings_chain = true, const char* duplicate_limit = nullptr)
+                      bool settings_chain = true, const char* duplicate_limit = nullptr,
+                      const vkkit::DeviceOptions& device = {})
       : settings_(protect, families, report, duplicate_limit),
-        fixture_(std::make_unique<Fixture>(settings_chain ? settings_.Chain() : nullptr)),
+        fixture_(std::make_unique<Fixture>(settings_chain ? settings_.Chain() : nullptr, device)),
         notices_(std::make_unique<NoticeListener>(fixture_->instance().handle())) {}
   ~ProtectRun() { Close(); }
   // Destroys the device and the instance now (vkDestroyDevice writes the protect summary).
@@ -356,7 +357,13 @@ TEST_CASE("protect: a record-time error of each family withholds the command and
 TEST_CASE("protect: vkQueueSubmit2 and a primary executing a marked secondary are withheld too",
           "[integration][protect]") {
   const RecordCase c = RecordCases()[3];  // alignment
-  ProtectRun run(c.family);
+  // vkQueueSubmit2 needs synchronization2 (03866): the withheld submission's emptied batch reaches the driver.
+  VkPhysicalDeviceSynchronization2Features synchronization2{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
+  synchronization2.synchronization2 = VK_TRUE;
+  vkkit::DeviceOptions options;
+  options.features = &synchronization2;
+  ProtectRun run(c.family, true, "", true, nullptr, options);
   vkkit::Device& device = run.device();
   Scene scene(device);
   Commands commands(device);
