@@ -188,6 +188,20 @@ void Reporter::ReportLayerAction(std::string_view id, const Location& loc, std::
   }
 }
 
+void Reporter::ReportUnchecked(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
+                               std::string_view message, NamedCounts counts) {
+  if (SeverityEnabled(Severity::kInfo)) {
+    Report(Severity::kInfo, id, loc, objects, message, counts);
+    return;
+  }
+  try {
+    if (!json_file_ || filter_.Mutes(id, MessageIdHash(id))) return;
+    WriteJson(Severity::kInfo, id, MessageIdHash(id), loc, objects, message, std::string_view(), counts);
+  } catch (const std::bad_alloc&) {
+    reports_lost_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
 void Reporter::Deliver(Severity severity, std::string_view vuid, uint32_t hash, bool last, const Location& loc,
                        std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts,
                        bool* skip_out) {

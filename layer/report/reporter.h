@@ -96,6 +96,11 @@ class Reporter {
   // why its app failed; the mute list still applies. Never asks to skip.
   void ReportLayerAction(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
                          std::string_view message);
+  // An information message that says what the layer could not check (a summary at vkDestroyDevice): delivered as
+  // report_flags says, like Report, and written to the JSON report even when report_flags leaves info out, since
+  // the gate (scripts/asval-run) must say what went unchecked whatever the app's output shows.
+  void ReportUnchecked(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
+                       std::string_view message, NamedCounts counts = {});
   bool protects() const { return settings_.protect; }
 
   // Findings delivered so far (after filters and limits), by severity, for summaries and tests.

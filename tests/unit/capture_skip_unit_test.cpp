@@ -26,13 +26,13 @@ namespace {
 
 using Counts = std::map<std::string, uint64_t>;
 
-// The summary lines ReportHistorySummary writes for `state`.
-std::vector<std::string> SummaryLines(const DeviceState& state) {
+// The summary lines ReportHistorySummary writes for `state` (report_flags with info, or without).
+std::vector<std::string> SummaryLines(const DeviceState& state, bool info = true) {
   asval_test_common::TempReport file;
   {
     ReportSettings settings;
     settings.report_file = file.path;
-    settings.report_info = true;
+    settings.report_info = info;
     Reporter reporter(settings);
     ReportHistorySummary(state, reporter, VK_NULL_HANDLE);
   }
@@ -67,6 +67,19 @@ TEST_CASE("capture skip unit: the summary names each reason's count in its text 
       "allocation_failed": 0})"));
   CHECK(asval_test_common::ReadCaptureSkipped({line}).NonZero() == Counts{{"over_capture_budget_mb", 2},
                                                                            {"unknown_address", 1}});
+}
+
+TEST_CASE("capture skip unit: without info in report_flags the summary still reaches the report when something was "
+          "not captured, and only then") {
+  DeviceState state;
+  state.capture_counters.infos_captured = 1;
+  CHECK(CaptureLine(SummaryLines(state, /*info=*/false)).empty());  // nothing went unchecked: report_flags decides
+  CHECK(!CaptureLine(SummaryLines(state, /*info=*/true)).empty());
+  state.capture_counters.NotCaptured(CaptureSkip::kUnknownAddress);
+  const std::string line = CaptureLine(SummaryLines(state, /*info=*/false));
+  REQUIRE(!line.empty());
+  CHECK(asval_test_common::ReadCaptureSkipped({line}).NonZero() == Counts{{"unknown_address", 1}});
+  CHECK(nlohmann::json::parse(line).value("severity", "") == "info");
 }
 
 TEST_CASE("capture skip unit: every reason has its own name and count") {
