@@ -8,6 +8,7 @@ after asval-run returned was not ended. Expectations written by hand; times are 
 machine, the SIGTERM/SIGKILL distinction is read from the gate's own words.
 """
 import argparse
+import ctypes
 import os
 import signal
 import subprocess
@@ -17,6 +18,7 @@ import time
 from asval_run_test import VUID, by_id, expect, failures, run
 
 GRACE = 5  # asval-run's SIGKILL grace, as its --help states
+PR_SET_CHILD_SUBREAPER = 36  # <linux/prctl.h>
 
 
 def alive(pid):
@@ -26,6 +28,19 @@ def alive(pid):
             return f.read().rsplit(")", 1)[1].split()[0] != "Z"
     except (OSError, IndexError):
         return False
+
+
+def reap_orphans():
+    """Reaps the zombies this process adopted as a subreaper; returns how many."""
+    count = 0
+    while True:
+        try:
+            pid, _ = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            return count
+        if pid == 0:
+            return count  # a child still running (none expected): not waited for
+        count += 1
 
 
 def end_survivor(pid):
@@ -161,7 +176,22 @@ def main():
                str(target))
         end_survivor(target)
 
-    # 6. Bad values: exit 64 with a message, and the command never runs.
+    # 6. Zombies do not hold the gate. This process becomes a child subreaper, so the command's orphans become its
+    # children, and reaps none until asval-run returned: as in a container whose first process reaps no orphan. The
+    # background sleep, ended by SIGTERM, stays a zombie in the group; the gate must not wait the grace for it.
+    libc = ctypes.CDLL(None, use_errno=True)
+    subreaper = libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0
+    expect("zombies: this test became a subreaper", subreaper, os.strerror(ctypes.get_errno()))
+    if subreaper:
+        proc, lines, _ = timed(args, ["--timeout", "1"], ["sh", "-c", "sleep 1000 & wait"], "timeout-zombie.jsonl")
+        orphans = reap_orphans()
+        libc.prctl(PR_SET_CHILD_SUBREAPER, 0, 0, 0, 0)
+        expect("zombies: exit 124", proc.returncode == 124, proc.stderr)
+        expect("zombies: ended with SIGTERM, no grace waited for a zombie",
+               "was ended by --timeout after 1 s, with SIGTERM (exit 124)" in proc.stderr, proc.stderr)
+        expect("zombies: the orphan was there, left to this process", orphans >= 1, str(orphans))
+
+    # 7. Bad values: exit 64 with a message, and the command never runs.
     for value in ("0", "-3", "soon", "nan", "inf"):
         marker = fresh(os.path.join(args.work, "timeout-bad-ran"))
         proc, lines, _ = timed(args, ["--timeout", value], ["touch", marker], "timeout-bad.jsonl")
