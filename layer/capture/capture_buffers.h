@@ -57,13 +57,19 @@ inline std::optional<CopySource> CopySourceIn(const DeviceState& state, MemoryAl
   return CopySource{alias->buffer, b.memory_offset + in_buffer, std::min(in_buffer_left, alias_left - in_buffer)};
 }
 
-// The copy source of [address, address + size).
+// The copy source of [address, address + size); nullopt with *why: no bound buffer of the app's covers the range
+// (kUnknownAddress), or one does but the layer has nothing it may name there (kBufferNotCopyable).
 inline std::optional<CopySource> CaptureCopySource(const DeviceState& state, MemoryAliases& aliases,
-                                                   VkDeviceAddress address, VkDeviceSize size) {
+                                                   VkDeviceAddress address, VkDeviceSize size, CaptureSkip* why) {
   std::shared_ptr<const BufferState> b;
   const std::optional<AddressHit> hit = BoundBufferCovering(state, address, size, &b);
-  if (!hit || !b) return std::nullopt;
-  return CopySourceIn(state, aliases, *b, hit->base, hit->size, address, size);
+  if (!hit || !b) {
+    *why = CaptureSkip::kUnknownAddress;
+    return std::nullopt;
+  }
+  std::optional<CopySource> source = CopySourceIn(state, aliases, *b, hit->base, hit->size, address, size);
+  if (!source) *why = CaptureSkip::kBufferNotCopyable;
+  return source;
 }
 
 }  // namespace asval

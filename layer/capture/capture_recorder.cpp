@@ -1,6 +1,7 @@
 #include "capture_recorder.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <limits>
 #include <new>
@@ -76,13 +77,13 @@ bool Reserve(const CaptureContext& ctx, CaptureLog& log, VkDeviceSize size, Capt
 
 // An allocation of the capture's own failed while it recorded a command's copies, before any was recorded: the
 // command captures nothing (its rules skipped and counted as for bytes not captured), and `needing` infos that
-// needed a capture are counted as not captured.
+// needed a capture are counted as not captured (kAllocationFailed).
 bool CaptureDropped(const CaptureContext& ctx, uint64_t needing, std::vector<uint32_t>& captured) {
   captured.clear();
   FailureCounters& failures = ctx.counters.failures;
   failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
   failures.capture_commands_dropped.fetch_add(1, std::memory_order_relaxed);
-  ctx.counters.infos_not_captured.fetch_add(needing, std::memory_order_relaxed);
+  ctx.counters.NotCaptured(CaptureSkip::kAllocationFailed, needing);
   return false;
 }
 
@@ -94,12 +95,15 @@ uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer
 // What a command's captures add to the counters, added once its copies are recorded (a command dropped by an
 // allocation failure adds nothing but its infos not captured).
 struct CommandCounts {
-  uint64_t captured = 0, bytes = 0, not_captured = 0, over_budget = 0;
+  uint64_t captured = 0, bytes = 0;
+  std::array<uint64_t, kCaptureSkipCount> not_captured{};  // per reason
+  void NotCaptured(CaptureSkip why) { ++not_captured[SkipIndex(why)]; }
   void AddTo(CaptureCounters& counters) const {
     counters.infos_captured.fetch_add(captured, std::memory_order_relaxed);
     counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
-    counters.infos_not_captured.fetch_add(not_captured, std::memory_order_relaxed);
-    counters.infos_over_budget.fetch_add(over_budget, std::memory_order_relaxed);
+    for (std::size_t r = 0; r < kCaptureSkipCount; ++r) {
+      counters.NotCaptured(static_cast<CaptureSkip>(r), not_captured[r]);
+    }
   }
 };
 
@@ -183,17 +187,19 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       const VkDeviceSize bytes =
           SaturatingAddBytes(SaturatingMulBytes(strides[i], n - 1), sizeof(VkAccelerationStructureBuildRangeInfoKHR));
       const bool within_budget = SaturatingAddBytes(log.bytes_captured, bytes) <= ctx.budget_bytes;
-      if (!within_budget) ++counts.over_budget;
+      CaptureSkip why = CaptureSkip::kOverBudget;
       const std::optional<CopySource> from =
-          within_budget ? CaptureCopySource(ctx.state, ctx.aliases, addresses[i], bytes) : std::nullopt;
-      if (from && Reserve(ctx, log, bytes, &entry.ranges)) {
+          within_budget ? CaptureCopySource(ctx.state, ctx.aliases, addresses[i], bytes, &why) : std::nullopt;
+      const bool reserved = from && Reserve(ctx, log, bytes, &entry.ranges);
+      if (from && !reserved) why = CaptureSkip::kCaptureMemoryFailed;
+      if (reserved) {
         copies.push_back(
             Copy{from->buffer, log.BufferOf(entry.ranges), VkBufferCopy{from->offset, entry.ranges.offset, bytes}});
         ++counts.captured;
         counts.bytes += bytes;
       } else {
         entry.complete = false;
-        ++counts.not_captured;
+        counts.NotCaptured(why);
       }
       planned.assign(n, CapturedGeometry{});
       for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
@@ -239,7 +245,7 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
     const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
     if (!info_ranges || (!info.pGeometries && !info.ppGeometries) || motion) {
-      ++counts.not_captured;
+      counts.NotCaptured(motion ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput);
       continue;
     }
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
@@ -258,9 +264,10 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
     first_source.assign(1, 0);
+    CaptureSkip why = CaptureSkip::kNullInput;  // the first reason that stopped the info, once it is not complete
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources);
+      entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources, &why);
       first_source.push_back(static_cast<uint32_t>(sources.size()));
     }
     if (!block_tried) {
@@ -303,26 +310,29 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     }
     if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
       entry.complete = false;
-      ++counts.over_budget;
+      why = CaptureSkip::kOverBudget;
     }
     const std::size_t first_copy = copies.size();
     const uint32_t first_job = block.dispatch.jobs;
     for (std::size_t j = 0; j < reduced.size() && entry.complete; ++j) {
       if (reduced[j] == kGathered) {
-        entry.complete = GatherInstancePointers(ctx.state, log, planned[j], sources[first_source[j]], block);
+        entry.complete = GatherInstancePointers(ctx.state, log, planned[j], sources[first_source[j]], block, &why);
         continue;
       }
       if (reduced[j] == kReduced) {
         entry.complete = ReduceGeometry(
             ctx.state, log, planned[j],
-            SourcesOf(planned[j], sources.data() + first_source[j], sources.data() + first_source[j + 1]), block);
+            SourcesOf(planned[j], sources.data() + first_source[j], sources.data() + first_source[j + 1]), block,
+            &why);
         continue;
       }
       for (uint32_t k = first_source[j]; k < first_source[j + 1]; ++k) {
         const CaptureSource& s = sources[k];
-        const std::optional<CopySource> from = CaptureCopySource(ctx.state, ctx.aliases, s.address, s.size);
+        CaptureSkip missing = CaptureSkip::kUnknownAddress;
+        const std::optional<CopySource> from = CaptureCopySource(ctx.state, ctx.aliases, s.address, s.size, &missing);
         if (!from && s.optional) continue;
         if (!from || !Reserve(ctx, log, s.size, s.into)) {
+          why = from ? CaptureSkip::kCaptureMemoryFailed : missing;
           entry.complete = false;
           break;
         }
@@ -332,7 +342,7 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     if (!entry.complete) {
       copies.resize(first_copy);
       block.dispatch.jobs = first_job;
-      ++counts.not_captured;
+      counts.NotCaptured(why);
     } else {
       ++counts.captured;
       counts.bytes += total;

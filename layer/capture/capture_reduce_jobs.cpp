@@ -91,14 +91,19 @@ bool Gatherable(const CapturedGeometry& g) {
 }
 
 bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
-                            const CaptureSource& pointers, JobBlock& block) {
-  if (!BoundBufferCovering(state, pointers.address, pointers.size) ||
-      block.dispatch.jobs >= block.capacity) {
+                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why) {
+  if (!BoundBufferCovering(state, pointers.address, pointers.size)) {
+    *why = CaptureSkip::kUnknownAddress;
     return false;
   }
   CapturedBytes out;
+  if (block.dispatch.jobs >= block.capacity) {  // the block was sized for every job: not reached
+    *why = CaptureSkip::kCaptureMemoryFailed;
+    return false;
+  }
   if (!log.Reserve(GatheredBytes(g.range.primitiveCount), &out)) {
     state.capture_counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);  // no slab
+    *why = CaptureSkip::kCaptureMemoryFailed;
     return false;
   }
   const VkDeviceSize pointer_bytes = 8 * VkDeviceSize{g.range.primitiveCount};
@@ -125,19 +130,25 @@ VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& source
 }
 
 bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
-                    JobBlock& block) {
+                    JobBlock& block, CaptureSkip* why) {
   const auto readable = [&](const CaptureSource* s) {
     return s && BoundBufferCovering(state, s->address, s->size).has_value();
   };
   const CaptureSource* indices = sources.indices;
   const CaptureSource* transform = readable(sources.transform) ? sources.transform : nullptr;  // optional
-  if (!readable(sources.data) || (indices && !readable(indices)) || block.dispatch.jobs >= block.capacity) {
+  if (!readable(sources.data) || (indices && !readable(indices))) {
+    *why = CaptureSkip::kUnknownAddress;
+    return false;
+  }
+  if (block.dispatch.jobs >= block.capacity) {  // the block was sized for every job: not reached
+    *why = CaptureSkip::kCaptureMemoryFailed;
     return false;
   }
   const VkDeviceSize index_bytes = indices ? indices->size : 0;
   CapturedBytes out;
   if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) {
     state.capture_counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);  // no slab
+    *why = CaptureSkip::kCaptureMemoryFailed;
     return false;
   }
   g.data = out;

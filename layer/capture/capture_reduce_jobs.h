@@ -45,13 +45,14 @@ bool Reducible(const CapturedGeometry& g);
 // followed one names (FollowedInstancePointer), into the log (CapturedGeometry::pointers, then ::data: GatheredBytes).
 // Gatherable: g is such an array, and the shader's 32-bit arithmetic holds its bytes; GatheredCost: what it costs
 // the recording's budget (the bytes and the job). GatherInstancePointers: false when the pointers cannot be read in
-// place (no bound buffer holds them) or there is no room: the info is then not captured.
+// place (no bound buffer holds them: *why kUnknownAddress) or there is no room (kCaptureMemoryFailed): the info is
+// then not captured.
 bool Gatherable(const CapturedGeometry& g);
 inline VkDeviceSize GatheredCost(const CapturedGeometry& g) {
   return GatheredBytes(g.range.primitiveCount) + sizeof(ReduceJob);
 }
 bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
-                            const CaptureSource& pointers, JobBlock& block);
+                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why);
 
 // Geometry g's sources among its planned ones [first, last): its data, and for triangles its indices and its
 // transform (each null when the plan has none).
@@ -66,9 +67,9 @@ VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& source
 
 // Geometry g's sources read in place by the command's dispatch: its results reserved in the log (the indices and
 // transform among them, where the builder's views find them), its job added to `block`. False when a source cannot
-// be read (no bound buffer holds it; the transform is then left out instead) or there is no room: the info is then
-// not captured.
+// be read (no bound buffer holds it: *why kUnknownAddress; the transform is then left out instead) or there is no
+// room (kCaptureMemoryFailed): the info is then not captured.
 bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
-                    JobBlock& block);
+                    JobBlock& block, CaptureSkip* why);
 
 }  // namespace asval

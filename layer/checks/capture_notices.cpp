@@ -166,15 +166,15 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
 
 void ReportCaptureBudget(const CheckContext& ctx, uint32_t budget_mb, const char* command) {
   CaptureCounters& counters = ctx.state.capture_counters;
-  if (counters.infos_over_budget.load(std::memory_order_relaxed) == 0 ||
+  if (counters.NotCapturedFor(CaptureSkip::kOverBudget) == 0 ||
       counters.budget_reported.exchange(true, std::memory_order_relaxed)) {
     return;
   }
   ctx.reporter.Report(Severity::kWarning, kCaptureBudgetId, Location(command), {},
                       fmt::format("A command buffer's captured build inputs would exceed capture_budget_mb ({} MB): the "
                                   "builds over it are not captured, and the rules that need their bytes are skipped "
-                                  "and counted (ASVAL-History-Summary). Raise capture_budget_mb to check them. "
-                                  "Reported once.",
+                                  "and counted (ASVAL-History-Summary: over_capture_budget_mb). Raise "
+                                  "capture_budget_mb to check them. Reported once.",
                                   budget_mb));
 }
 

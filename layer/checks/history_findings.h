@@ -16,6 +16,8 @@ namespace asval {
 inline constexpr const char kClobberedId[] = "ASVAL-History-Clobbered";
 // The layer-specific id of the summary of history checks skipped for unknown history (info, at vkDestroyDevice).
 inline constexpr const char kHistorySummaryId[] = "ASVAL-History-Summary";
+// The JSON key of the summary's counts of infos not captured, per reason (capture_skip.h; scripts/asval-run reads it).
+inline constexpr const char kCaptureSkippedField[] = "capture_skipped";
 
 struct HistoryFinding {
   Severity severity;

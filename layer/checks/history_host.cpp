@@ -2,12 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <memory>
 #include <mutex>
 #include <new>
+#include <string>
 #include <vector>
 
 #include "activity_rules.h"
+#include "capture_skip.h"
 #include "history_apply.h"
 #include "history_findings.h"
 #include "history_recorder.h"
@@ -132,17 +135,27 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
   const HistoryStore& store = state.history.store;
   const uint64_t skipped = store.rules_skipped_unknown_history.load(std::memory_order_relaxed);
   const CaptureCounters& capture = state.capture_counters;
-  const uint64_t not_captured = capture.infos_not_captured.load(std::memory_order_relaxed);
+  const uint64_t not_captured = capture.InfosNotCaptured();
   if (not_captured != 0 || capture.infos_captured.load(std::memory_order_relaxed) != 0) {
+    // Each reason by its name (capture_skip.h): in the text those not zero, in the JSON line's "capture_skipped"
+    // every one, zeros included, so that a tool finds each name in every such line.
+    std::array<NamedCount, kCaptureSkipCount> reasons;
+    std::string named;
+    for (std::size_t r = 0; r < kCaptureSkipCount; ++r) {
+      const CaptureSkip why = static_cast<CaptureSkip>(r);
+      reasons[r] = NamedCount{NameOf(why), capture.NotCapturedFor(why)};
+      if (reasons[r].count != 0) named += fmt::format(" {}={}", reasons[r].name, reasons[r].count);
+    }
     reporter.Report(Severity::kInfo, kHistorySummaryId, Location("vkDestroyDevice"),
                     {Obj(VK_OBJECT_TYPE_DEVICE, device)},
                     fmt::format("Execution-time capture: {} build infos captured ({} bytes), {} updates judged on "
-                                "their captured activity; {} infos that a rule needed could not be captured (their "
-                                "rules were skipped and counted: a geometry kind or format not captured yet, a "
-                                "buffer the layer could not copy, or over capture_budget_mb).",
+                                "their captured activity; {} infos that a rule needed could not be captured{}{} "
+                                "(their rules were skipped and counted; docs/capture.md says what each reason means).",
                                 capture.infos_captured.load(std::memory_order_relaxed),
                                 capture.bytes_captured.load(std::memory_order_relaxed),
-                                capture.updates_compared.load(std::memory_order_relaxed), not_captured));
+                                capture.updates_compared.load(std::memory_order_relaxed), not_captured,
+                                not_captured != 0 ? ":" : "", named),
+                    NamedCounts{kCaptureSkippedField, reasons.data(), reasons.size()});
   }
   const uint64_t blobs = capture.blobs_captured.load(std::memory_order_relaxed);
   const uint64_t blobs_missed = capture.blobs_not_captured.load(std::memory_order_relaxed);

@@ -18,8 +18,9 @@ std::string Cause(const std::string& vuid, const std::string& where) {
 
 // What every withheld submission's notice says happened to it (the text goes on after it).
 constexpr const char kSubmissionNotPassedDown[] =
-    "the submission was not passed down and returned VK_ERROR_VALIDATION_FAILED_EXT (nothing of it ran; its fence "
-    "and semaphores are not signaled";
+    "the submission's command buffers were not passed down and it returned VK_ERROR_VALIDATION_FAILED_EXT (none of "
+    "them ran; its batches went down empty, with their semaphore waits and signals and its fence, so that what waits "
+    "for it still completes";
 
 }  // namespace
 
@@ -93,13 +94,18 @@ void ReportProtectSummary(const DeviceState& state, Reporter& reporter, VkDevice
   const uint64_t commands = c.commands_withheld.load(std::memory_order_relaxed);
   const uint64_t submissions = c.submissions_withheld.load(std::memory_order_relaxed);
   const uint64_t host = c.host_commands_withheld.load(std::memory_order_relaxed);
+  const uint64_t lost = c.synchronizations_lost.load(std::memory_order_relaxed);
   const bool halted = state.protect_halt.Cause() != nullptr;
   if (commands == 0 && submissions == 0 && host == 0 && !halted) return;
   reporter.ReportLayerAction(
       kHistorySummaryId, Location("vkDestroyDevice"), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
       fmt::format("Protect mode kept from the driver: recorded_commands_withheld={} submissions_withheld={} "
-                  "host_commands_withheld={} submissions_halted_by_completion_error={} (each named in an {} message).",
-                  commands, submissions, host, halted ? 1 : 0, kProtectWithheldId));
+                  "host_commands_withheld={} submissions_halted_by_completion_error={} (each named in an {} message).{}",
+                  commands, submissions, host, halted ? 1 : 0, kProtectWithheldId,
+                  lost == 0 ? ""
+                            : fmt::format(" The layer could not allocate the empty batches of {} withheld submissions: "
+                                          "their fences and semaphores were not signaled.",
+                                          lost)));
 }
 
 }  // namespace asval

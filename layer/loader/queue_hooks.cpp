@@ -3,16 +3,19 @@
 // layer/state/submission.h; the rules: SubmitChecks, layer/checks/submit_checks.h). A finding whose callback
 // returns VK_TRUE keeps the whole submission from the driver, as the Khronos layer does, and its history
 // changes are undone; so are those of a submission the driver rejects. In protect mode (withhold.h) so does any
-// error found at submission, and a submitted command buffer that lacks a command the layer withheld.
+// error found at submission, and a submitted command buffer that lacks a command the layer withheld: its batches
+// still go down, emptied of their command buffers (synchronization_only.h), so that what waits for it completes.
 // Batches are applied in an order the device can execute them in (layer/state/submission_order.h): one that waits
 // for a timeline value nothing has signaled yet is deferred until a later call signals it (ordered_batches.h).
 #include <mutex>
+#include <new>
 #include <optional>
 
 #include "layer_data.h"
 #include "ordered_batches.h"
 #include "submission.h"
 #include "submit_checks.h"
+#include "synchronization_only.h"
 #include "vk_intercepts.h"
 #include "withhold.h"
 
@@ -30,12 +33,53 @@ void HoldDeferredLogs(const RecordedOps& ops, SubmissionCaptures& captures) {
   }
 }
 
+// A call whose batches touch no structure's history (a sparse bind; a withheld submission's emptied batches) but whose
+// semaphores order the batches that do: a batch that waits for an unsignaled value holds back what it signals, and
+// the values it signals may let deferred batches run. Returns the downcall's result.
+template <typename HasSemaphores, typename SemaphoresOf, typename Downcall>
+VkResult PassDownInOrder(DeviceData& data, const char* function, VkQueue queue, uint32_t batch_count,
+                         HasSemaphores&& has_semaphores, SemaphoresOf&& semaphores_of, Downcall&& downcall) {
+  SubmissionOrder& order = data.state.history.order;
+  if (!data.state.history_tracked || !(order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
+    return downcall();
+  }
+  std::lock_guard<std::recursive_mutex> lock(data.state.history.submission_order);
+  SubmissionOrder::Call call(order, queue, function);
+  for (uint32_t i = 0; i < batch_count; ++i) call.Place(semaphores_of(i));
+  const VkResult result = downcall();
+  if (result == VK_SUCCESS) {
+    call.Commit();
+    ApplyReadyBatches(data);
+  }
+  return result;
+}
+
+// Protect mode withheld the submission: its batches go down emptied (`emptied_downcall`), so that its fence, its
+// semaphore signals and its waits complete as the app expects; it returns VK_ERROR_VALIDATION_FAILED_EXT (or the
+// driver's error). Should the emptied batches not fit in memory, nothing goes down (counted).
+template <typename HasSemaphores, typename SemaphoresOf, typename EmptiedDowncall>
+VkResult SynchronizeWithheld(DeviceData& data, const char* function, VkQueue queue, uint32_t batch_count,
+                             HasSemaphores&& has_semaphores, SemaphoresOf&& semaphores_of,
+                             EmptiedDowncall&& emptied_downcall) {
+  try {
+    const VkResult result =
+        PassDownInOrder(data, function, queue, batch_count, has_semaphores, semaphores_of, emptied_downcall);
+    return result == VK_SUCCESS ? VK_ERROR_VALIDATION_FAILED_EXT : result;
+  } catch (const std::bad_alloc&) {
+    RecordSynchronizationLost(data.state);
+    return VK_ERROR_VALIDATION_FAILED_EXT;
+  }
+}
+
 // semaphores_of(i): batch i's BatchSemaphores; for_each_command_buffer_in(i, visit) calls visit(cb, location, j)
 // for every command buffer of batch i, in order. has_semaphores(): some batch waits or signals.
-template <typename HasSemaphores, typename SemaphoresOf, typename ForEachCommandBufferIn, typename Downcall>
+// emptied_downcall(): the call's batches without their command buffers, with its fence (SynchronizeWithheld).
+template <typename HasSemaphores, typename SemaphoresOf, typename ForEachCommandBufferIn, typename Downcall,
+          typename EmptiedDowncall>
 VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence fence, uint32_t batch_count,
                 HasSemaphores&& has_semaphores, SemaphoresOf&& semaphores_of,
-                ForEachCommandBufferIn&& for_each_command_buffer_in, Downcall&& downcall) {
+                ForEachCommandBufferIn&& for_each_command_buffer_in, Downcall&& downcall,
+                EmptiedDowncall&& emptied_downcall) {
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
@@ -45,7 +89,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
     }
   };
   if (data.reporter->protects() && WithholdSubmission(data, function, queue, for_each_command_buffer)) {
-    return VK_ERROR_VALIDATION_FAILED_EXT;
+    return SynchronizeWithheld(data, function, queue, batch_count, has_semaphores, semaphores_of, emptied_downcall);
   }
   const CheckContext ctx = MakeCheckContext(data);
   // Execution order across queues: only a device with timeline semaphores, or with batches deferred, pays for it.
@@ -81,11 +125,11 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   const ProtectScope protect(data.reporter->protects());
   if (checks.ReportAll()) {
     submission.Undo();
-    if (protect.withheld()) {
-      RecordWithheldSubmission(data.state);
-      ReportWithheldSubmission(ctx, function, queue, protect);
-    }
-    return VK_ERROR_VALIDATION_FAILED_EXT;
+    if (!protect.withheld()) return VK_ERROR_VALIDATION_FAILED_EXT;  // the app's VK_TRUE: a plain skip
+    RecordWithheldSubmission(data.state);
+    ReportWithheldSubmission(ctx, function, queue, protect);
+    call.reset();  // what its batches noted is forgotten; the emptied batches are placed anew
+    return SynchronizeWithheld(data, function, queue, batch_count, has_semaphores, semaphores_of, emptied_downcall);
   }
   // Pre-record: the recordings whose captures run now count as pending before the device may write them.
   // Without a fence of the app's, the layer's own goes down in its place and tells when the bytes are there.
@@ -136,7 +180,11 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t submitCount, 
           visit(pSubmits[i].pCommandBuffers[j], root.Field("pSubmits", i).Field("pCommandBuffers", j), j);
         }
       },
-      [&](VkFence down_fence) { return data->dispatch.QueueSubmit(queue, submitCount, pSubmits, down_fence); });
+      [&](VkFence down_fence) { return data->dispatch.QueueSubmit(queue, submitCount, pSubmits, down_fence); },
+      [&] {
+        const EmptiedSubmits emptied(submitCount, pSubmits);
+        return data->dispatch.QueueSubmit(queue, emptied.count(), emptied.submits(), fence);
+      });
 }
 
 // Also vkQueueSubmit2KHR (the generated intercept table maps the alias here).
@@ -159,33 +207,27 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t submitCount,
                 root.Field("pSubmits", i).Field("pCommandBufferInfos", j).Field("commandBuffer"), j);
         }
       },
-      [&](VkFence down_fence) { return data->dispatch.QueueSubmit2(queue, submitCount, pSubmits, down_fence); });
+      [&](VkFence down_fence) { return data->dispatch.QueueSubmit2(queue, submitCount, pSubmits, down_fence); },
+      [&] {
+        const EmptiedSubmits2 emptied(submitCount, pSubmits);
+        return data->dispatch.QueueSubmit2(queue, emptied.count(), emptied.submits(), fence);
+      });
 }
 
-// Sparse binding touches no structure's history, but its semaphores order the batches that do: a bind that waits
-// for an unsignaled value holds back what it signals, and the values it signals may let deferred batches run.
+// Sparse binding touches no structure's history, but its semaphores order the batches that do.
 VKAPI_ATTR VkResult VKAPI_CALL QueueBindSparse(VkQueue queue, uint32_t bindInfoCount, const VkBindSparseInfo* pBindInfo,
                                                VkFence fence) {
   DeviceData* data = GetDeviceData(queue);
-  SubmissionOrder& order = data->state.history.order;
-  const auto has_semaphores = [&] {
-    for (uint32_t i = 0; i < bindInfoCount; ++i) {
-      if (pBindInfo[i].waitSemaphoreCount != 0 || pBindInfo[i].signalSemaphoreCount != 0) return true;
-    }
-    return false;
-  };
-  if (!data->state.history_tracked || !(order.backlog() != 0 || (order.any_timeline() && has_semaphores()))) {
-    return data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence);
-  }
-  std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
-  SubmissionOrder::Call call(order, queue, "vkQueueBindSparse");
-  for (uint32_t i = 0; i < bindInfoCount; ++i) call.Place(SemaphoresOf(pBindInfo[i]));
-  const VkResult result = data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence);
-  if (result == VK_SUCCESS) {
-    call.Commit();
-    ApplyReadyBatches(*data);
-  }
-  return result;
+  return PassDownInOrder(
+      *data, "vkQueueBindSparse", queue, bindInfoCount,
+      [&] {
+        for (uint32_t i = 0; i < bindInfoCount; ++i) {
+          if (pBindInfo[i].waitSemaphoreCount != 0 || pBindInfo[i].signalSemaphoreCount != 0) return true;
+        }
+        return false;
+      },
+      [&](uint32_t i) { return SemaphoresOf(pBindInfo[i]); },
+      [&] { return data->dispatch.QueueBindSparse(queue, bindInfoCount, pBindInfo, fence); });
 }
 
 }  // namespace asval::hooks

@@ -145,10 +145,10 @@ bool Reporter::CountDuplicate(uint32_t hash, bool* last) {
 }
 
 bool Reporter::Report(Severity severity, std::string_view vuid_in, const Location& loc,
-                      std::initializer_list<ReportObject> objects, std::string_view message) {
+                      std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts) {
   bool skip = false;
   try {
-    ReportOrThrow(severity, vuid_in, loc, objects, message, &skip);
+    ReportOrThrow(severity, vuid_in, loc, objects, message, counts, &skip);
   } catch (const std::bad_alloc&) {
     // The message could not be built or written (the layer's allocation failed, or a callback's): lost, counted
     // (ASVAL-History-Summary says how many), never thrown into the app's Vulkan call. A callback that already
@@ -159,7 +159,8 @@ bool Reporter::Report(Severity severity, std::string_view vuid_in, const Locatio
 }
 
 void Reporter::ReportOrThrow(Severity severity, std::string_view vuid_in, const Location& loc,
-                             std::initializer_list<ReportObject> objects, std::string_view message, bool* skip) {
+                             std::initializer_list<ReportObject> objects, std::string_view message,
+                             NamedCounts counts, bool* skip) {
   if (!SeverityEnabled(severity)) return;
   const std::string_view vuid = NewestVuid(vuid_in);
   const uint32_t hash = MessageIdHash(vuid);
@@ -171,7 +172,7 @@ void Reporter::ReportOrThrow(Severity severity, std::string_view vuid_in, const 
   bool last = false;
   if (!CountDuplicate(hash, &last)) return;
   CounterFor(severity).fetch_add(1, std::memory_order_relaxed);
-  Deliver(severity, vuid, hash, last, loc, objects, message, skip);
+  Deliver(severity, vuid, hash, last, loc, objects, message, counts, skip);
 }
 
 void Reporter::ReportLayerAction(std::string_view id, const Location& loc, std::initializer_list<ReportObject> objects,
@@ -181,14 +182,15 @@ void Reporter::ReportLayerAction(std::string_view id, const Location& loc, std::
     if (filter_.Mutes(id, hash)) return;
     CounterFor(Severity::kInfo).fetch_add(1, std::memory_order_relaxed);
     bool skip_ignored = false;
-    Deliver(Severity::kInfo, id, hash, /*last=*/false, loc, objects, message, &skip_ignored);
+    Deliver(Severity::kInfo, id, hash, /*last=*/false, loc, objects, message, NamedCounts{}, &skip_ignored);
   } catch (const std::bad_alloc&) {
     reports_lost_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 
 void Reporter::Deliver(Severity severity, std::string_view vuid, uint32_t hash, bool last, const Location& loc,
-                       std::initializer_list<ReportObject> objects, std::string_view message, bool* skip_out) {
+                       std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts,
+                       bool* skip_out) {
   bool& skip = *skip_out;
   const VuidInfo* info = FindVuid(vuid);
   const std::string_view spec_text = info ? std::string_view(info->spec_text) : std::string_view();
@@ -266,7 +268,7 @@ void Reporter::Deliver(Severity severity, std::string_view vuid, uint32_t hash, 
   if (!delivered || settings_.log_to_stderr) {
     stderr_logger_->log(LogLevel(severity), text);
   }
-  WriteJson(severity, vuid, hash, loc, objects, message, spec_text);
+  WriteJson(severity, vuid, hash, loc, objects, message, spec_text, counts);
 }
 
 std::atomic<uint64_t>& Reporter::CounterFor(Severity severity) {
@@ -280,7 +282,7 @@ std::atomic<uint64_t>& Reporter::CounterFor(Severity severity) {
 
 void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
                          std::initializer_list<ReportObject> objects, std::string_view message,
-                         std::string_view spec_text) {
+                         std::string_view spec_text, NamedCounts counts) {
   if (!json_file_) return;
   nlohmann::ordered_json json_objects = nlohmann::ordered_json::array();
   for (const ReportObject& o : objects) {
@@ -290,7 +292,7 @@ void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash
     if (!name.empty()) object["name"] = name;
     json_objects.push_back(std::move(object));
   }
-  const nlohmann::ordered_json line = {
+  nlohmann::ordered_json line = {
       {"severity", SeverityName(severity)},
       {"vuid", vuid},
       {"message_id", Hex(hash)},
@@ -300,6 +302,11 @@ void Reporter::WriteJson(Severity severity, std::string_view vuid, uint32_t hash
       {"message", message},
       {"spec_text", spec_text},
   };
+  if (!counts.field.empty()) {
+    nlohmann::ordered_json named = nlohmann::ordered_json::object();
+    for (std::size_t i = 0; i < counts.size; ++i) named[std::string(counts.counts[i].name)] = counts.counts[i].count;
+    line[std::string(counts.field)] = std::move(named);
+  }
   WriteLine(JsonLine(line));
 }
 

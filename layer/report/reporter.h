@@ -6,6 +6,7 @@
 #include <vulkan/vulkan.h>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
@@ -42,6 +43,18 @@ struct ReportObject {
   uint64_t handle;
 };
 
+// Counts a message carries in its JSON line as one object, {"name": count, ...}, under the key `field` (the
+// summaries' counts, so that a tool reads them without parsing the text). Views of the caller's, used during Report.
+struct NamedCount {
+  std::string_view name;
+  uint64_t count;
+};
+struct NamedCounts {
+  std::string_view field;  // empty: none
+  const NamedCount* counts = nullptr;
+  std::size_t size = 0;
+};
+
 template <typename Handle>
 ReportObject Obj(VkObjectType type, Handle handle) {
   return ReportObject{type, reinterpret_cast<uint64_t>(handle)};
@@ -74,8 +87,9 @@ class Reporter {
   // Reports one finding. vuid may be an older spelling: the newest is reported. Returns true when the call must
   // not be passed down: a messenger callback returned VK_TRUE (the app asks the layer to skip it), or, in protect
   // mode, the finding is an error (noted in the thread's ProtectScope, protect_scope.h).
+  // `counts`: named counts for the JSON line (NamedCounts); the text says them itself.
   bool Report(Severity severity, std::string_view vuid, const Location& loc,
-              std::initializer_list<ReportObject> objects, std::string_view message);
+              std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts = {});
 
   // Reports what the layer itself did to the app's call (protect mode withheld it): an information message that
   // report_flags and the duplicate limit do not hide, since each withheld call is named once and a CI run must see
@@ -106,18 +120,21 @@ class Reporter {
 
   // Report's body; *skip is set as soon as a callback asks to skip, so that it stands if a later step throws.
   void ReportOrThrow(Severity severity, std::string_view vuid, const Location& loc,
-                     std::initializer_list<ReportObject> objects, std::string_view message, bool* skip);
+                     std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts,
+                     bool* skip);
   // Builds the text and delivers it (messengers, stderr, JSON): what is left of a report after the filters.
   // `last`: this is the last message the duplicate limit lets through for its id.
   void Deliver(Severity severity, std::string_view vuid, uint32_t hash, bool last, const Location& loc,
-               std::initializer_list<ReportObject> objects, std::string_view message, bool* skip);
+               std::initializer_list<ReportObject> objects, std::string_view message, NamedCounts counts,
+               bool* skip);
   bool SeverityEnabled(Severity s) const;
   // Returns false when the duplicate limit drops the message; sets *last when this is the last one allowed.
   bool CountDuplicate(uint32_t hash, bool* last);
   std::string ObjectName(VkObjectType type, uint64_t handle) const;
   std::atomic<uint64_t>& CounterFor(Severity severity);
   void WriteJson(Severity severity, std::string_view vuid, uint32_t hash, const Location& loc,
-                 std::initializer_list<ReportObject> objects, std::string_view message, std::string_view spec_text);
+                 std::initializer_list<ReportObject> objects, std::string_view message, std::string_view spec_text,
+                 NamedCounts counts);
   void WriteLine(const std::string& line);  // one JSON line to the report file, flushed
 
   const ReportSettings settings_;

@@ -10,6 +10,7 @@
 #include <vulkan/vulkan.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "asval/builder/geometry_view.h"
+#include "capture_skip.h"
 #include "failure_counters.h"
 #include "memory_range.h"
 
@@ -26,9 +28,19 @@ namespace asval {
 struct CaptureCounters {
   std::atomic<uint64_t> infos_captured{0};
   std::atomic<uint64_t> bytes_captured{0};
-  // Infos a rule needed but that could not be captured (no copyable buffer, over the budget, a geometry kind
-  // or format not captured yet, no host-visible memory).
-  std::atomic<uint64_t> infos_not_captured{0};
+  // Infos a rule needed but that could not be captured, per reason (capture_skip.h); their total is the sum.
+  std::array<std::atomic<uint64_t>, kCaptureSkipCount> infos_not_captured{};
+  void NotCaptured(CaptureSkip why, uint64_t infos = 1) {
+    if (infos != 0) infos_not_captured[SkipIndex(why)].fetch_add(infos, std::memory_order_relaxed);
+  }
+  uint64_t NotCapturedFor(CaptureSkip why) const {
+    return infos_not_captured[SkipIndex(why)].load(std::memory_order_relaxed);
+  }
+  uint64_t InfosNotCaptured() const {
+    uint64_t total = 0;
+    for (const std::atomic<uint64_t>& n : infos_not_captured) total += n.load(std::memory_order_relaxed);
+    return total;
+  }
   // Updates whose activity rules (03663/03664/03768) were judged on captured bytes.
   std::atomic<uint64_t> updates_compared{0};
   // Device serialization bytes (vkCmdCopyAccelerationStructureToMemoryKHR's written, vkCmdCopyMemoryTo...'s read):
@@ -40,9 +52,7 @@ struct CaptureCounters {
   // changed before the completion was processed).
   std::atomic<uint64_t> deserializations_restored{0};
   std::atomic<uint64_t> deserializations_unverified{0};
-  // Infos not captured because the recording's captures would have exceeded capture_budget_mb (included in
-  // infos_not_captured), and whether that was reported (once per device).
-  std::atomic<uint64_t> infos_over_budget{0};
+  // Whether infos not captured for capture_budget_mb (CaptureSkip::kOverBudget) were reported (once per device).
   std::atomic<bool> budget_reported{false};
   // The layer's own failures, capture or not (failure_counters.h): kept here because every writer reaches
   // DeviceState::capture_counters.

@@ -15,7 +15,11 @@ constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);          
 
 bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
                           const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
-                          std::vector<CaptureSource>& sources) {
+                          std::vector<CaptureSource>& sources, CaptureSkip* why) {
+  const auto not_captured = [why](CaptureSkip reason) {
+    *why = reason;
+    return false;
+  };
   // Host builds give host pointers in the same unions: read the member the command uses.
   const auto address = [host](const VkDeviceOrHostAddressConstKHR& a) -> uint64_t {
     return host ? reinterpret_cast<uint64_t>(a.hostAddress) : a.deviceAddress;
@@ -27,12 +31,12 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
     const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
     const VertexFormatInfo& format = VertexFormatFacts(t.vertexFormat);
     const int index_bytes = builder::IndexTypeBytes(t.indexType);  // the builder's: it reads them
-    if (!format.decodable || index_bytes < 0) return false;
+    if (!format.decodable || index_bytes < 0) return not_captured(CaptureSkip::kGeometryNotCaptured);
     out->vertex_format = t.vertexFormat;
     out->vertex_stride = t.vertexStride;
     out->index_type = t.indexType;
     if (n == 0) return true;
-    if (address(t.vertexData) == 0) return false;
+    if (address(t.vertexData) == 0) return not_captured(CaptureSkip::kNullInput);
     if (address(t.transformData) != 0) {
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.transformData), r.transformOffset), kTransformBytes,
                                       &out->transform, true});
@@ -46,7 +50,7 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
       out->max_vertex = t.maxVertex >= r.firstVertex ? t.maxVertex - r.firstVertex : 0;
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.vertexData), first), bytes, &out->data});
     } else {
-      if (address(t.indexData) == 0) return false;
+      if (address(t.indexData) == 0) return not_captured(CaptureSkip::kNullInput);
       // Indices from primitiveOffset; vertices index + firstVertex up to maxVertex, from vertexData.
       out->max_vertex = t.maxVertex;
       out->range.firstVertex = r.firstVertex;
@@ -62,7 +66,7 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
     const VkAccelerationStructureGeometryAabbsDataKHR& a = g.geometry.aabbs;
     out->aabb_stride = a.stride;
     if (n == 0) return true;
-    if (address(a.data) == 0) return false;
+    if (address(a.data) == 0) return not_captured(CaptureSkip::kNullInput);
     sources.push_back(CaptureSource{SaturatingAddBytes(address(a.data), r.primitiveOffset),
                                     SaturatingAddBytes(SaturatingMulBytes(a.stride, n - 1), kAabbBytes), &out->data});
     return true;
@@ -74,14 +78,14 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
     // where it has one (layer/capture), else unknown.
     out->array_of_pointers = in.arrayOfPointers == VK_TRUE;
     if (n == 0) return true;
-    if (address(in.data) == 0) return false;
+    if (address(in.data) == 0) return not_captured(CaptureSkip::kNullInput);
     const VkDeviceSize record_bytes = out->array_of_pointers ? sizeof(VkDeviceAddress) : kInstanceBytes;
     sources.push_back(CaptureSource{SaturatingAddBytes(address(in.data), r.primitiveOffset),
                                     SaturatingMulBytes(record_bytes, n),
                                     out->array_of_pointers ? &out->pointers : &out->data});
     return true;
   }
-  return false;
+  return not_captured(CaptureSkip::kGeometryNotCaptured);  // a geometry type the builder does not know
 }
 
 }  // namespace asval

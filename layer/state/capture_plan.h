@@ -39,9 +39,10 @@ struct CaptureSource {
 
 // The ranges geometry g reads into `sources` (appended), its captured parameters into *out. `host`: the
 // geometry's addresses are host pointers (vkBuildAccelerationStructuresKHR). False when the geometry is not
-// captured (a kind or format the builder does not read, a null address with primitives to read).
+// captured, and *why says why: a kind or format the builder does not read (kGeometryNotCaptured), a null address
+// with primitives to read (kNullInput).
 bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
                           const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
-                          std::vector<CaptureSource>& sources);
+                          std::vector<CaptureSource>& sources, CaptureSkip* why);
 
 }  // namespace asval

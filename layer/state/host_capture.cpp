@@ -28,9 +28,10 @@ class HeapSlabOwner final : public CaptureSlabOwner {
 
 namespace {
 
+// `uncounted`: the first info not yet counted as captured or not (an allocation failure counts those from there).
 HostCapture CaptureOrThrow(uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, VkDeviceSize budget_bytes,
-                           CaptureCounters& counters) {
+                           CaptureCounters& counters, uint32_t* uncounted) {
   HostCapture capture;
   InjectBadAlloc(FailSite::kCaptureRecord);
   std::vector<CaptureSource> sources;
@@ -48,22 +49,25 @@ HostCapture CaptureOrThrow(uint32_t info_count, const VkAccelerationStructureBui
     entry.element = i;
     planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
-    const bool readable = ranges[i] && (info.pGeometries || info.ppGeometries) &&
-                          (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) == 0;
-    entry.complete = readable;
+    // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
+    const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
+    CaptureSkip why = motion ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput;  // once not complete
+    entry.complete = ranges[i] && (info.pGeometries || info.ppGeometries) && !motion;
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanCapturedGeometry(*g, ranges[i][j], true, &planned[j], sources);
+      entry.complete = g && PlanCapturedGeometry(*g, ranges[i][j], true, &planned[j], sources, &why);
     }
     VkDeviceSize total = 0;
     for (const CaptureSource& s : sources) total = SaturatingAddBytes(total, s.size);
     if (entry.complete && SaturatingAddBytes(log.bytes_captured, total) > budget_bytes) {
       entry.complete = false;
-      counters.infos_over_budget.fetch_add(1, std::memory_order_relaxed);
+      why = CaptureSkip::kOverBudget;
     }
     for (const CaptureSource& s : sources) {
       if (!entry.complete) break;
-      if (!log.Reserve(s.size, s.into)) {
+      if (!log.Reserve(s.size, s.into)) {  // the heap block could not be had
+        counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);
+        why = CaptureSkip::kCaptureMemoryFailed;
         entry.complete = false;
         break;
       }
@@ -74,8 +78,9 @@ HostCapture CaptureOrThrow(uint32_t info_count, const VkAccelerationStructureBui
       counters.infos_captured.fetch_add(1, std::memory_order_relaxed);
       counters.bytes_captured.fetch_add(total, std::memory_order_relaxed);
     } else {
-      counters.infos_not_captured.fetch_add(1, std::memory_order_relaxed);
+      counters.NotCaptured(why);
     }
+    *uncounted = i + 1;
     capture.captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
   return capture;
@@ -87,13 +92,18 @@ HostCapture CaptureHostBuildInputs(uint32_t info_count, const VkAccelerationStru
                                    const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                                    VkDeviceSize budget_bytes, CaptureCounters& counters) {
   if (!infos || !ranges) return HostCapture{};
+  uint32_t uncounted = 0;
   try {
-    return CaptureOrThrow(info_count, infos, ranges, budget_bytes, counters);
+    return CaptureOrThrow(info_count, infos, ranges, budget_bytes, counters, &uncounted);
   } catch (const std::bad_alloc&) {
     // Nothing captured: the call's updates are not judged on their inputs, and its builds leave no activity
-    // (skipped and counted where a later update needs it). The infos counted before the failure stay counted.
+    // (skipped and counted where a later update needs it). The infos counted before the failure stay counted; those
+    // from the failure on are counted as not captured for it.
     counters.failures.allocation_failures.fetch_add(1, std::memory_order_relaxed);
     counters.failures.capture_commands_dropped.fetch_add(1, std::memory_order_relaxed);
+    for (uint32_t i = uncounted; i < info_count; ++i) {
+      if (ActivityNeededForUpdates(infos[i])) counters.NotCaptured(CaptureSkip::kAllocationFailed);
+    }
     return HostCapture{};
   }
 }

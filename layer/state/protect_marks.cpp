@@ -48,4 +48,9 @@ void RecordWithheldHostCommand(DeviceState& state) {
   state.protect_counters.host_commands_withheld.fetch_add(1, std::memory_order_relaxed);
 }
 
+void RecordSynchronizationLost(DeviceState& state) {
+  state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  state.protect_counters.synchronizations_lost.fetch_add(1, std::memory_order_relaxed);
+}
+
 }  // namespace asval

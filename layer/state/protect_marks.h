@@ -51,6 +51,9 @@ struct ProtectCounters {
   std::atomic<uint64_t> commands_withheld{0};       // recorded commands not passed down (their buffers marked)
   std::atomic<uint64_t> submissions_withheld{0};    // queue submissions not passed down
   std::atomic<uint64_t> host_commands_withheld{0};  // host builds, copies and property writes not run
+  // Withheld submissions whose emptied batches (layer/loader/synchronization_only.h) the layer could not make (its
+  // allocation failed): nothing of them went down, so their fence and semaphores were not signaled.
+  std::atomic<uint64_t> synchronizations_lost{0};
 };
 
 class DeviceState;
@@ -67,5 +70,7 @@ void RecordSubmissionHalt(DeviceState& state, std::string_view function, std::st
 // A queue submission, or a host command, protect mode kept from the driver.
 void RecordWithheldSubmission(DeviceState& state);
 void RecordWithheldHostCommand(DeviceState& state);
+// A withheld submission's emptied batches could not be made: nothing of it went down.
+void RecordSynchronizationLost(DeviceState& state);
 
 }  // namespace asval

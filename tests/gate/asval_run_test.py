@@ -88,6 +88,28 @@ def main():
     proc, lines = run(args, [], ["true"], "true.jsonl")
     expect("a passing command: 0", proc.returncode == 0 and "asval reported nothing" in proc.stderr, proc.stderr)
 
+    # 5. The summary's capture skips (ASVAL-History-Summary's "capture_skipped" field, one line per device): printed
+    # per reason, summed over the devices, zeros left out. The command writes two devices' summary lines into the
+    # report itself (the layer's own lines with that field are asserted by tests/integration/capture_skip_test.cpp).
+    summaries = [
+        {"severity": "info", "vuid": "ASVAL-History-Summary", "function": "vkDestroyDevice", "message": "device 1",
+         "capture_skipped": {"over_capture_budget_mb": 2, "unknown_address": 0, "geometry_not_captured": 1}},
+        {"severity": "info", "vuid": "ASVAL-History-Summary", "function": "vkDestroyDevice", "message": "device 2",
+         "capture_skipped": {"over_capture_budget_mb": 1, "unknown_address": 3, "geometry_not_captured": 0}},
+    ]
+    write = ("import json, os, sys\n"
+             "with open(os.environ['VK_ASVAL_AS_VALIDATION_REPORT_FILE'], 'a') as f:\n"
+             "    f.write(sys.argv[1])\n")
+    text = "".join(json.dumps(l) + "\n" for l in summaries)
+    proc, lines = run(args, [], [sys.executable, "-c", write, text], "skips.jsonl")
+    expect("capture skips: the command passes", proc.returncode == 0, proc.stderr)
+    expect("capture skips: summed over devices, per reason",
+           "capture: 7 build input(s) a rule needed could not be captured, their checks skipped: "
+           "over_capture_budget_mb 3, unknown_address 3, geometry_not_captured 1" in proc.stderr, proc.stderr)
+    proc, lines = run(args, [], [sys.executable, "-c", write, json.dumps(dict(summaries[0], capture_skipped={
+        "over_capture_budget_mb": 0})) + "\n"], "no-skips.jsonl")
+    expect("capture skips: none, no line", "capture:" not in proc.stderr, proc.stderr)
+
     if failures:
         print("%d check(s) failed" % len(failures))
         return 1

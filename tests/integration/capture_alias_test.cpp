@@ -10,12 +10,15 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <string>
 
 #include "capture_helpers.h"
+#include "capture_skipped.h"
 #include "history_helpers.h"
 #include "memory_placement_helpers.h"
+#include "temp_report.h"
 
 namespace asval_test {
 namespace {
@@ -209,6 +212,55 @@ TEST_CASE("capture alias: inputs in a dedicated allocation are captured from the
   }
   vkDestroyBuffer(device.handle(), placed.buffer, nullptr);
   vkFreeMemory(device.handle(), placed.memory, nullptr);
+}
+
+// Memory exported to other APIs (VkExportMemoryAllocateInfo with handle types) is memory the layer binds no buffer of
+// its own to (MemoryState::layer_may_bind), and the app's buffer there is external, which the layer does not make
+// copyable: inputs there cannot be copied. The build and its update are not captured, each counted as
+// buffer_not_copyable in ASVAL-History-Summary, and the update's activity change is not judged (never a guess).
+TEST_CASE("capture alias: inputs in exported memory cannot be copied: not captured, counted as buffer_not_copyable",
+          "[integration][capture][alias]") {
+  // Reduced on the device, the inputs are read through their device address in place: nothing to copy through.
+  if (CaptureReducedRun()) SKIP("capture_method=reduce: the inputs are read in place, captured");
+  asval_test_common::TempReport report;
+  {
+    HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"}});
+    vkkit::Device& device = f.device();
+    VkExternalMemoryBufferCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO};
+    external.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+    VkBufferCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, &external};
+    create.size = 1024;
+    create.usage = kInputUsage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    create.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    vkkit::Buffer placed;
+    placed.size = create.size;
+    vkkit::Check(vkCreateBuffer(device.handle(), &create, nullptr, &placed.buffer), "vkCreateBuffer");
+    VkMemoryRequirements requirements;
+    vkGetBufferMemoryRequirements(device.handle(), placed.buffer, &requirements);
+    VkExportMemoryAllocateInfo exported{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO};
+    exported.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO, &exported};
+    flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = device.FindMemoryType(
+        requirements.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    vkkit::Check(vkAllocateMemory(device.handle(), &allocate, nullptr, &placed.memory), "vkAllocateMemory");
+    vkkit::Check(vkBindBufferMemory(device.handle(), placed.buffer, placed.memory, 0), "vkBindBufferMemory");
+    vkkit::Check(vkMapMemory(device.handle(), placed.memory, 0, VK_WHOLE_SIZE, 0, &placed.mapped), "vkMapMemory");
+    const VkBufferDeviceAddressInfo address{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, placed.buffer};
+    placed.address = vkGetBufferDeviceAddress(device.handle(), &address);
+    {
+      Prerecorded commands(device, placed);
+      commands.Run(true);  // copyable, this would fire pInfos-03663 (the dedicated-allocation test above)
+      CHECK(f.monitor().Verify() == "");
+    }
+    vkDestroyBuffer(device.handle(), placed.buffer, nullptr);
+    vkFreeMemory(device.handle(), placed.memory, nullptr);
+    f.Close();  // vkDestroyDevice writes the summary
+  }
+  CHECK(asval_test_common::ReadCaptureSkipped(report.Lines()).NonZero() ==
+        std::map<std::string, uint64_t>{{"buffer_not_copyable", 2}});
 }
 
 }  // namespace

@@ -6,11 +6,14 @@
 #include <catch2/catch_test_macros.hpp>
 
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "capture_helpers.h"
+#include "capture_skipped.h"
 #include "history_helpers.h"
+#include "temp_report.h"
 
 namespace asval_test {
 namespace {
@@ -109,6 +112,39 @@ TEST_CASE("capture: capture_budget_mb bounds each recording of a command buffer,
   CHECK(OneBudgetWarning(f.monitor()) == "");
   CHECK(scene.commands().Submit(one) == VK_SUCCESS);
   CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("capture: infos over capture_budget_mb are counted in ASVAL-History-Summary as over_capture_budget_mb",
+          "[capture]") {
+  if (CaptureReducedRun()) SKIP("capture_method=reduce: these builds stay under the budget");
+  asval_test_common::TempReport report;
+  {
+    HistoryFixture f(nullptr, {{"capture_budget_mb", "1"},
+                               {"capture_method", "copy"},
+                               {"report_file", report.path.c_str()},
+                               {"report_flags", "error,warn,info"}});
+    {
+      Scene scene(f.device());
+      // One recording whose second build crosses the budget (the first is captured), one over it alone, and one
+      // under it: 2 infos not captured, 2 captured.
+      CHECK(scene.commands().Submit(scene.Recording({kUnderOneMiB, kUnderOneMiB})) == VK_SUCCESS);
+      CHECK(scene.commands().Submit(scene.Recording({kOverOneMiB})) == VK_SUCCESS);
+      CHECK(scene.commands().Submit(scene.Recording({kUnderOneMiB})) == VK_SUCCESS);
+      CHECK(OneBudgetWarning(f.monitor()) == "");
+    }
+    f.Close();  // vkDestroyDevice writes the summary
+  }
+  const std::vector<std::string> lines = report.Lines();
+  const asval_test_common::CaptureSkipped skipped = asval_test_common::ReadCaptureSkipped(lines);
+  CHECK(skipped.lines == 1);
+  CHECK(skipped.NonZero() == std::map<std::string, uint64_t>{{"over_capture_budget_mb", 2}});
+  bool said = false;
+  for (const std::string& line : lines) {
+    said |= line.find("Execution-time capture: 2 build infos captured") != std::string::npos &&
+            line.find("; 2 infos that a rule needed could not be captured: over_capture_budget_mb=2 (") !=
+                std::string::npos;
+  }
+  CHECK(said);
 }
 
 }  // namespace

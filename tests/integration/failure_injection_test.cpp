@@ -15,12 +15,14 @@
 #include <array>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <memory>
 #include <regex>
 #include <string>
 #include <vector>
 
 #include "capture_helpers.h"
+#include "capture_skipped.h"
 #include "history_helpers.h"
 #include "temp_report.h"
 
@@ -40,6 +42,7 @@ struct Outcome {
   std::vector<Message> after_update;  // messages up to the update's wait (the finding is reported in it)
   std::vector<Message> after_query;   // messages after that (none expected)
   std::vector<std::string> summary;   // the ASVAL-History-Summary messages of the JSON report
+  asval_test_common::CaptureSkipped skipped;  // their infos not captured, per reason ("capture_skipped")
 };
 
 VkResult SubmitAlone(vkkit::Device& device, VkCommandBuffer cb) {
@@ -100,6 +103,7 @@ Outcome Run(const char* fail, std::vector<std::pair<const char*, const char*>> s
     }
     f->Close();  // vkDestroyDevice writes the summary
   }
+  out.skipped = asval_test_common::ReadCaptureSkipped(report.Lines());
   for (const std::string& line : report.Lines()) {
     if (!nlohmann::json::accept(line)) continue;
     const nlohmann::json j = nlohmann::json::parse(line);
@@ -188,13 +192,24 @@ TEST_CASE("failure injection: without a failure the update's activity change is 
   CHECK(HistorySkips(o).empty());  // nothing skipped for unknown history
   // The build (ALLOW_UPDATE) and the update captured; the update judged.
   CHECK(Captured(o) == std::vector<uint64_t>{2, 1, 0});
+  // Every reason an info may be skipped for is in the summary's JSON field, at 0.
+  CHECK(o.skipped.lines == 1);
+  CHECK(o.skipped.counts == std::map<std::string, uint64_t>{{"over_capture_budget_mb", 0},
+                                                            {"unknown_address", 0},
+                                                            {"buffer_not_copyable", 0},
+                                                            {"geometry_not_captured", 0},
+                                                            {"null_input", 0},
+                                                            {"capture_memory_failed", 0},
+                                                            {"allocation_failed", 0}});
 }
 
-// What the summary must say under each failure: the failure line, the history line (empty: none), the capture line.
+// What the summary must say under each failure: the failure line, the history line (empty: none), the capture line,
+// and the reasons of the infos not captured (those counted: the capture line's last number, by name).
 struct Expected {
   std::vector<uint64_t> failures;
   std::vector<uint64_t> history;
   std::vector<uint64_t> captured;
+  std::map<std::string, uint64_t> not_captured = {};
 };
 
 void CheckSkipped(const char* fail, const Expected& expected,
@@ -211,6 +226,7 @@ void CheckSkipped(const char* fail, const Expected& expected,
   CHECK(Failures(failed) == expected.failures);
   CHECK(HistorySkips(failed) == expected.history);
   CHECK(Captured(failed) == expected.captured);
+  CHECK(failed.skipped.NonZero() == expected.not_captured);
 }
 
 TEST_CASE("failure injection: a recording whose operation could not be appended is lost, its effects unknown",
@@ -248,13 +264,14 @@ TEST_CASE("failure injection: capture memory that could not be had leaves the bu
           "[integration][failures]") {
   // capture_memory:1 is the first capture slab, for the build: the build is not captured (1), the update is (its
   // slab is the second); the update's source activity is unknown, so it is not judged. No history is unknown.
-  CheckSkipped("capture_memory:1", {{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}, {}, {1, 0, 1}});
+  CheckSkipped("capture_memory:1",
+               {{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}, {}, {1, 0, 1}, {{"capture_memory_failed", 1}}});
 }
 
 TEST_CASE("failure injection: the capture's own bookkeeping failing drops the command's captures",
           "[integration][failures]") {
   // capture_alloc:1 is the build command's capture: dropped (1 command, its 1 info not captured).
-  CheckSkipped("capture_alloc:1", {{1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0}, {}, {1, 0, 1}});
+  CheckSkipped("capture_alloc:1", {{1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0}, {}, {1, 0, 1}, {{"allocation_failed", 1}}});
 }
 
 TEST_CASE("failure injection: without a fence of the layer's, a submission's captures are never read",
@@ -285,7 +302,8 @@ TEST_CASE("failure injection: the reducing pipeline failing makes the capture co
 TEST_CASE("failure injection: several failures at once are each counted", "[integration][failures]") {
   // The build's append (state_record:1) and the first capture slab (capture_memory:1): the lost recording as in
   // its own test, and the build not captured.
-  CheckSkipped("state_record:1,capture_memory:1", {{1, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0}, {1, 2}, {1, 0, 1}});
+  CheckSkipped("state_record:1,capture_memory:1",
+               {{1, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0}, {1, 2}, {1, 0, 1}, {{"capture_memory_failed", 1}}});
 }
 
 }  // namespace

@@ -443,4 +443,52 @@ void CmdCopyBuffer(VkCommandBuffer cb, const vkkit::Buffer& src, const vkkit::Bu
   vkCmdCopyBuffer(cb, src.buffer, dst.buffer, 1, &region);
 }
 
+
+vkkit::DeviceOptions TimelineDevice(uint32_t queues) {
+  vkkit::DeviceOptions options;
+  options.timeline_semaphore = true;
+  options.queue_count = queues;
+  return options;
+}
+
+Timeline::Timeline(vkkit::Device& device) : device_(device) {
+  VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE, 0};
+  const VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+  vkkit::Check(vkCreateSemaphore(device.handle(), &info, nullptr, &semaphore_), "vkCreateSemaphore");
+}
+
+Timeline::~Timeline() { vkDestroySemaphore(device_.handle(), semaphore_, nullptr); }
+
+VkResult Timeline::HostSignal(uint64_t value) {
+  const VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO, nullptr, semaphore_, value};
+  return vkSignalSemaphore(device_.handle(), &info);
+}
+
+VkResult Timeline::HostWait(uint64_t value, uint64_t timeout_ns) {
+  VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+  info.semaphoreCount = 1;
+  info.pSemaphores = &semaphore_;
+  info.pValues = &value;
+  return vkWaitSemaphores(device_.handle(), &info, timeout_ns);
+}
+
+VkResult SubmitOn(VkQueue queue, VkCommandBuffer cb, const Timeline& timeline, uint64_t wait, uint64_t signal) {
+  const VkSemaphore semaphore = timeline.handle();
+  const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+  VkTimelineSemaphoreSubmitInfo values{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  values.waitSemaphoreValueCount = wait ? 1 : 0;
+  values.pWaitSemaphoreValues = &wait;
+  values.signalSemaphoreValueCount = signal ? 1 : 0;
+  values.pSignalSemaphoreValues = &signal;
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO, &values};
+  submit.waitSemaphoreCount = wait ? 1 : 0;
+  submit.pWaitSemaphores = &semaphore;
+  submit.pWaitDstStageMask = &stage;
+  submit.signalSemaphoreCount = signal ? 1 : 0;
+  submit.pSignalSemaphores = &semaphore;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  return vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE);
+}
+
 }  // namespace asval_test

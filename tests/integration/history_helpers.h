@@ -229,4 +229,28 @@ void CmdWriteProperties(vkkit::Device& device, VkCommandBuffer cb, std::vector<V
 // vkCmdCopyBuffer of `size` bytes (a write the layer does not track).
 void CmdCopyBuffer(VkCommandBuffer cb, const vkkit::Buffer& src, const vkkit::Buffer& dst, VkDeviceSize size);
 
+
+// A device with timeline semaphores and `queues` queues of its family (as many as it offers: Device::queue_count()).
+vkkit::DeviceOptions TimelineDevice(uint32_t queues = 1);
+
+// A timeline semaphore (initial value 0).
+class Timeline {
+ public:
+  explicit Timeline(vkkit::Device& device);
+  ~Timeline();
+  Timeline(const Timeline&) = delete;
+  Timeline& operator=(const Timeline&) = delete;
+  VkSemaphore handle() const { return semaphore_; }
+  VkResult HostSignal(uint64_t value);
+  // vkWaitSemaphores for `value`, at most `timeout_ns`.
+  VkResult HostWait(uint64_t value, uint64_t timeout_ns);
+
+ private:
+  vkkit::Device& device_;
+  VkSemaphore semaphore_ = VK_NULL_HANDLE;
+};
+
+// Submits cb on `queue`, waiting for timeline >= wait (0: no wait) and signaling `signal` (0: none); no fence.
+VkResult SubmitOn(VkQueue queue, VkCommandBuffer cb, const Timeline& timeline, uint64_t wait, uint64_t signal);
+
 }  // namespace asval_test

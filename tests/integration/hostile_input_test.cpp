@@ -13,9 +13,11 @@
 #include <chrono>
 #include <functional>
 #include <cstring>
+#include <map>
 #include <regex>
 #include <thread>
 
+#include "capture_skipped.h"
 #include "history_helpers.h"
 #include "memory_placement_helpers.h"
 #include "record_checks_helpers.h"
@@ -377,6 +379,9 @@ TEST_CASE("hostile: an updatable build whose vertices lie outside every buffer i
   const Summary s = ReadSummary(report);
   REQUIRE(s.found_capture);
   CHECK(s.infos_not_captured == 1);
+  // Named: the address lies in no buffer the layer knows.
+  CHECK(asval_test_common::ReadCaptureSkipped(report.Lines()).NonZero() ==
+        std::map<std::string, uint64_t>{{"unknown_address", 1}});
 }
 
 TEST_CASE("hostile: structure handles the layer never saw are reported where a rule names them, counted elsewhere",

@@ -16,13 +16,6 @@ namespace {
 
 constexpr const char* k03762 = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03762";
 
-vkkit::DeviceOptions TimelineDevice(uint32_t queues = 1) {
-  vkkit::DeviceOptions options;
-  options.timeline_semaphore = true;
-  options.queue_count = queues;
-  return options;
-}
-
 // Geometry flags are among what an update must repeat (03762), and a mismatch is harmless to the driver that
 // executes it (the firing tests' updates go down: a deferred batch was submitted before it could be judged).
 Shape Flags(VkGeometryFlagsKHR flags) {
@@ -32,46 +25,6 @@ Shape Flags(VkGeometryFlagsKHR flags) {
 }
 const Shape kOpaque = Flags(VK_GEOMETRY_OPAQUE_BIT_KHR);
 const Shape kNoDuplicate = Flags(VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR);
-
-class Timeline {
- public:
-  explicit Timeline(vkkit::Device& device) : device_(device) {
-    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE,
-                                   0};
-    const VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
-    vkkit::Check(vkCreateSemaphore(device.handle(), &info, nullptr, &semaphore_), "vkCreateSemaphore");
-  }
-  ~Timeline() { vkDestroySemaphore(device_.handle(), semaphore_, nullptr); }
-  VkSemaphore handle() const { return semaphore_; }
-  VkResult HostSignal(uint64_t value) {
-    const VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO, nullptr, semaphore_, value};
-    return vkSignalSemaphore(device_.handle(), &info);
-  }
-
- private:
-  vkkit::Device& device_;
-  VkSemaphore semaphore_ = VK_NULL_HANDLE;
-};
-
-// Submits cb on `queue`, waiting for timeline >= wait (0: no wait) and signaling `signal` (0: none); no fence.
-VkResult SubmitOn(VkQueue queue, VkCommandBuffer cb, const Timeline& timeline, uint64_t wait, uint64_t signal) {
-  const VkSemaphore semaphore = timeline.handle();
-  const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
-  VkTimelineSemaphoreSubmitInfo values{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
-  values.waitSemaphoreValueCount = wait ? 1 : 0;
-  values.pWaitSemaphoreValues = &wait;
-  values.signalSemaphoreValueCount = signal ? 1 : 0;
-  values.pSignalSemaphoreValues = &signal;
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO, &values};
-  submit.waitSemaphoreCount = wait ? 1 : 0;
-  submit.pWaitSemaphores = &semaphore;
-  submit.pWaitDstStageMask = &stage;
-  submit.signalSemaphoreCount = signal ? 1 : 0;
-  submit.pSignalSemaphores = &semaphore;
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  return vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE);
-}
 
 VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBuffer cb = commands.Begin();

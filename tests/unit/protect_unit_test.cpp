@@ -47,8 +47,15 @@ struct Calls {
   int host_build = 0;
   int host_copy = 0;
   int host_write_properties = 0;
+  // Submissions whose command buffers reached the driver; those that reached it emptied (a withheld submission's
+  // synchronization, layer/loader/synchronization_only.h), and the last of those.
   int queue_submit = 0;
   int queue_submit2 = 0;
+  int emptied_submit = 0;
+  int emptied_submit2 = 0;
+  std::vector<VkSubmitInfo> emptied;
+  std::vector<VkSubmitInfo2> emptied2;
+  VkFence emptied_fence = VK_NULL_HANDLE;
 } g_calls;
 
 VKAPI_ATTR void VKAPI_CALL FakeCmdBuild(VkCommandBuffer, uint32_t, const VkAccelerationStructureBuildGeometryInfoKHR*,
@@ -89,12 +96,28 @@ VKAPI_ATTR VkResult VKAPI_CALL FakeHostWriteProperties(VkDevice, uint32_t, const
   ++g_calls.host_write_properties;
   return VK_SUCCESS;
 }
-VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t, const VkSubmitInfo*, VkFence) {
-  ++g_calls.queue_submit;
+VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
+  uint32_t command_buffers = 0;
+  for (uint32_t i = 0; i < count; ++i) command_buffers += submits[i].commandBufferCount;
+  if (command_buffers != 0 || count == 0) {
+    ++g_calls.queue_submit;
+    return VK_SUCCESS;
+  }
+  ++g_calls.emptied_submit;
+  g_calls.emptied.assign(submits, submits + count);
+  g_calls.emptied_fence = fence;
   return VK_SUCCESS;
 }
-VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit2(VkQueue, uint32_t, const VkSubmitInfo2*, VkFence) {
-  ++g_calls.queue_submit2;
+VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit2(VkQueue, uint32_t count, const VkSubmitInfo2* submits, VkFence fence) {
+  uint32_t command_buffers = 0;
+  for (uint32_t i = 0; i < count; ++i) command_buffers += submits[i].commandBufferInfoCount;
+  if (command_buffers != 0 || count == 0) {
+    ++g_calls.queue_submit2;
+    return VK_SUCCESS;
+  }
+  ++g_calls.emptied_submit2;
+  g_calls.emptied2.assign(submits, submits + count);
+  g_calls.emptied_fence = fence;
   return VK_SUCCESS;
 }
 VKAPI_ATTR VkResult VKAPI_CALL FakeBegin(VkCommandBuffer, const VkCommandBufferBeginInfo*) { return VK_SUCCESS; }
@@ -262,6 +285,9 @@ class FakeDevice {
   }
   std::shared_ptr<const WithheldCommand> Withheld(int i) const { return state_->command_buffers.Withheld(cb(i)); }
   const ProtectCounters& counters() const { return state_->protect_counters; }
+  // An error judged at completion halts every later submission (withhold.h: HaltSubmissionsAfter).
+  void Halt() { RecordSubmissionHalt(*state_, "vkCmdBuildAccelerationStructuresKHR", kHaltVuid, "pInfos[0]"); }
+  static constexpr const char kHaltVuid[] = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03663";
   VkQueryPool QueryPool(VkQueryType type, uint32_t count) {
     VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     info.queryType = type;
@@ -1217,6 +1243,148 @@ TEST_CASE("protect: the JSON report has one ASVAL-Protect-Withheld line per with
                                  "vkQueueSubmit", "vkBuildAccelerationStructuresKHR"});
   CHECK(errors == 3);   // the errors themselves: two recorded, one host
   CHECK(summaries == 1);
+}
+
+
+// ---- a withheld submission still completes the app's synchronization -------------------------------------------
+
+// The waits, signals and fence of one batch the tests submit: a binary wait (with its stage), a binary signal and a
+// timeline signal of value 7 (its value in a chained VkTimelineSemaphoreSubmitInfo).
+struct SynchronizedBatch {
+  VkSemaphore waits[1] = {Fake<VkSemaphore>(0x51)};
+  VkPipelineStageFlags stages[1] = {VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR};
+  VkSemaphore signals[2] = {Fake<VkSemaphore>(0x52), Fake<VkSemaphore>(0x53)};
+  uint64_t wait_values[1] = {0};
+  uint64_t signal_values[2] = {0, 7};
+  VkTimelineSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  VkCommandBuffer cb;
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  VkFence fence = Fake<VkFence>(0x54);
+
+  explicit SynchronizedBatch(int i) : cb(FakeDevice::cb(i)) {
+    timeline.waitSemaphoreValueCount = 1;
+    timeline.pWaitSemaphoreValues = wait_values;
+    timeline.signalSemaphoreValueCount = 2;
+    timeline.pSignalSemaphoreValues = signal_values;
+    submit.pNext = &timeline;
+    submit.waitSemaphoreCount = 1;
+    submit.pWaitSemaphores = waits;
+    submit.pWaitDstStageMask = stages;
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    submit.signalSemaphoreCount = 2;
+    submit.pSignalSemaphores = signals;
+  }
+  VkResult Submit() const { return hooks::QueueSubmit(FakeDevice::queue(), 1, &submit, fence); }
+  // What reached the driver in its place: the same batch with no command buffer, and the same fence.
+  void ExpectEmptiedTwin() const {
+    REQUIRE(g_calls.emptied_submit == 1);
+    REQUIRE(g_calls.emptied.size() == 1);
+    const VkSubmitInfo& down = g_calls.emptied[0];
+    CHECK(down.commandBufferCount == 0);
+    CHECK(down.pCommandBuffers == nullptr);
+    CHECK(down.waitSemaphoreCount == 1);
+    CHECK(down.pWaitSemaphores == waits);
+    CHECK(down.pWaitDstStageMask == stages);
+    CHECK(down.signalSemaphoreCount == 2);
+    CHECK(down.pSignalSemaphores == signals);
+    CHECK(down.pNext == &timeline);  // the timeline values, as the app chained them
+    CHECK(g_calls.emptied_fence == fence);
+    CHECK(g_calls.queue_submit == 0);
+  }
+};
+
+TEST_CASE("protect: a submission withheld for a marked command buffer goes down emptied, with its waits, signals "
+          "and fence",
+          "[protect][synchronization]") {
+  FakeDevice d(Protect());
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  d.Forget();
+  const SynchronizedBatch batch(0);
+  CHECK(batch.Submit() == VK_ERROR_VALIDATION_FAILED_EXT);
+  batch.ExpectEmptiedTwin();
+  CHECK(d.counters().submissions_withheld.load() == 1);
+  const std::vector<Message> notices = d.Notices();
+  REQUIRE(notices.size() == 1);
+  CHECK(notices[0].text.find("its batches went down empty") != std::string::npos);
+}
+
+TEST_CASE("protect: a submission withheld for an error in execution order goes down emptied, its history undone",
+          "[protect][synchronization]") {
+  FakeDevice d(Protect());
+  RecordRebuildThenUpdate(d);  // command buffer 1: an update that contradicts the first build
+  const uint64_t generation = d.Generation(d.a);
+  const SynchronizedBatch batch(1);
+  CHECK(batch.Submit() == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(d.Generation(d.a) == generation);
+  REQUIRE(g_calls.emptied_submit == 1);
+  CHECK(g_calls.emptied[0].commandBufferCount == 0);
+  CHECK(g_calls.emptied[0].pSignalSemaphores == batch.signals);
+  CHECK(g_calls.emptied_fence == batch.fence);
+  CHECK(g_calls.queue_submit == 1);  // RecordRebuildThenUpdate's first submission only
+}
+
+TEST_CASE("protect: after a halt every submission goes down emptied; with protect off a VK_TRUE skip passes nothing",
+          "[protect][synchronization]") {
+  SECTION("halted") {
+    FakeDevice d(Protect());
+    d.Begin(0);
+    TriangleBuild(d, d.a, 1, false).Record(FakeDevice::cb(0));  // valid
+    d.End(0);
+    d.Halt();
+    d.Forget();
+    const SynchronizedBatch batch(0);
+    CHECK(batch.Submit() == VK_ERROR_VALIDATION_FAILED_EXT);
+    batch.ExpectEmptiedTwin();
+    // A call with no batch at all still signals its fence.
+    CHECK(hooks::QueueSubmit(FakeDevice::queue(), 0, nullptr, batch.fence) == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(g_calls.queue_submit == 1);  // the empty call reached the driver as it was
+    CHECK(d.counters().submissions_withheld.load() == 2);
+  }
+  SECTION("protect off, the app's callback skips the submission") {
+    FakeDevice d(Protect(false), VK_TRUE);
+    RecordRebuildThenUpdate(d);
+    const SynchronizedBatch batch(1);
+    CHECK(batch.Submit() == VK_ERROR_VALIDATION_FAILED_EXT);
+    CHECK(g_calls.emptied_submit == 0);  // the app chose the skip, as with the Khronos layer
+  }
+}
+
+TEST_CASE("protect: vkQueueSubmit2 withheld goes down emptied with its semaphore infos and fence",
+          "[protect][synchronization]") {
+  FakeDevice d(Protect());
+  d.Begin(0);
+  RecordInvalidBuild(d, 0);
+  d.End(0);
+  d.Forget();
+  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  wait.semaphore = Fake<VkSemaphore>(0x61);
+  wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  signal.semaphore = Fake<VkSemaphore>(0x62);
+  signal.value = 3;
+  VkCommandBufferSubmitInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cb_info.commandBuffer = FakeDevice::cb(0);
+  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  submit.waitSemaphoreInfoCount = 1;
+  submit.pWaitSemaphoreInfos = &wait;
+  submit.commandBufferInfoCount = 1;
+  submit.pCommandBufferInfos = &cb_info;
+  submit.signalSemaphoreInfoCount = 1;
+  submit.pSignalSemaphoreInfos = &signal;
+  const VkFence fence = Fake<VkFence>(0x63);
+  CHECK(hooks::QueueSubmit2(FakeDevice::queue(), 1, &submit, fence) == VK_ERROR_VALIDATION_FAILED_EXT);
+  REQUIRE(g_calls.emptied_submit2 == 1);
+  const VkSubmitInfo2& down = g_calls.emptied2[0];
+  CHECK(down.commandBufferInfoCount == 0);
+  CHECK(down.waitSemaphoreInfoCount == 1);
+  CHECK(down.pWaitSemaphoreInfos == &wait);
+  CHECK(down.signalSemaphoreInfoCount == 1);
+  CHECK(down.pSignalSemaphoreInfos == &signal);
+  CHECK(g_calls.emptied_fence == fence);
+  CHECK(g_calls.queue_submit2 == 0);
 }
 
 }  // namespace
