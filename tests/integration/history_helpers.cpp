@@ -444,6 +444,19 @@ void CmdCopyBuffer(VkCommandBuffer cb, const vkkit::Buffer& src, const vkkit::Bu
 }
 
 
+Shape WithGeometryFlags(VkGeometryFlagsKHR flags) {
+  Shape s;
+  s.geometry_flags = flags;
+  return s;
+}
+
+VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBuffer cb = commands.Begin();
+  record(cb);
+  commands.End(cb);
+  return cb;
+}
+
 vkkit::DeviceOptions TimelineDevice(uint32_t queues) {
   vkkit::DeviceOptions options;
   options.timeline_semaphore = true;

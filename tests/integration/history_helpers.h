@@ -2,6 +2,7 @@
 // Helpers for the build-history and copies tests: command buffers recorded now and submitted later (in any
 // order, more than once), bottom- and top-level structures whose builds and updates take a "shape" (the
 // parameters an update must repeat), copies, serialization and property queries.
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -229,6 +230,15 @@ void CmdWriteProperties(vkkit::Device& device, VkCommandBuffer cb, std::vector<V
 // vkCmdCopyBuffer of `size` bytes (a write the layer does not track).
 void CmdCopyBuffer(VkCommandBuffer cb, const vkkit::Buffer& src, const vkkit::Buffer& dst, VkDeviceSize size);
 
+
+// Shapes that differ only in their geometry flags: among what an update must repeat (03762), and a mismatch is
+// harmless to a driver that executes it (tests whose invalid update goes down use them).
+Shape WithGeometryFlags(VkGeometryFlagsKHR flags);
+inline const Shape kOpaque = WithGeometryFlags(VK_GEOMETRY_OPAQUE_BIT_KHR);
+inline const Shape kNoDuplicate = WithGeometryFlags(VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR);
+
+// A new primary command buffer of `commands` with what `record` records, ended.
+VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record);
 
 // A device with timeline semaphores and `queues` queues of its family (as many as it offers: Device::queue_count()).
 vkkit::DeviceOptions TimelineDevice(uint32_t queues = 1);

@@ -12,7 +12,6 @@
 #include <catch2/catch_test_macros.hpp>
 
 #include <cstring>
-#include <functional>
 
 #include "history_helpers.h"
 
@@ -22,21 +21,6 @@ namespace {
 constexpr const char* k03762 = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03762";
 constexpr uint64_t kTenSeconds = 10'000'000'000ull;
 constexpr uint32_t kFill = 0xabababab;
-
-Shape Flags(VkGeometryFlagsKHR flags) {
-  Shape s;
-  s.geometry_flags = flags;
-  return s;
-}
-const Shape kOpaque = Flags(VK_GEOMETRY_OPAQUE_BIT_KHR);
-const Shape kNoDuplicate = Flags(VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR);
-
-VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
-  VkCommandBuffer cb = commands.Begin();
-  record(cb);
-  commands.End(cb);
-  return cb;
-}
 
 // A host-visible buffer of zeros that a recorded vkCmdFillBuffer marks: whether that command ran.
 class Marker {

@@ -16,23 +16,6 @@ namespace {
 
 constexpr const char* k03762 = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03762";
 
-// Geometry flags are among what an update must repeat (03762), and a mismatch is harmless to the driver that
-// executes it (the firing tests' updates go down: a deferred batch was submitted before it could be judged).
-Shape Flags(VkGeometryFlagsKHR flags) {
-  Shape s;
-  s.geometry_flags = flags;
-  return s;
-}
-const Shape kOpaque = Flags(VK_GEOMETRY_OPAQUE_BIT_KHR);
-const Shape kNoDuplicate = Flags(VK_GEOMETRY_NO_DUPLICATE_ANY_HIT_INVOCATION_BIT_KHR);
-
-VkCommandBuffer Recorded(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
-  VkCommandBuffer cb = commands.Begin();
-  record(cb);
-  commands.End(cb);
-  return cb;
-}
-
 TEST_CASE("order: an update waiting for a value the host signals later is judged when the host signals it (03762)",
           "[integration][history][order][passes-invalid-down]") {
   HistoryFixture f("history", {}, TimelineDevice());

@@ -96,29 +96,30 @@ VKAPI_ATTR VkResult VKAPI_CALL FakeHostWriteProperties(VkDevice, uint32_t, const
   ++g_calls.host_write_properties;
   return VK_SUCCESS;
 }
-VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
+// A submission reaches the "driver": counted in `reached` when some batch holds a command buffer (or there is no
+// batch), else in `emptied_calls`, its batches kept in `emptied`.
+template <typename SubmitInfo>
+VkResult CountSubmission(uint32_t count, const SubmitInfo* submits, VkFence fence,
+                         uint32_t SubmitInfo::*command_buffer_count, int& reached, int& emptied_calls,
+                         std::vector<SubmitInfo>& emptied) {
   uint32_t command_buffers = 0;
-  for (uint32_t i = 0; i < count; ++i) command_buffers += submits[i].commandBufferCount;
+  for (uint32_t i = 0; i < count; ++i) command_buffers += submits[i].*command_buffer_count;
   if (command_buffers != 0 || count == 0) {
-    ++g_calls.queue_submit;
+    ++reached;
     return VK_SUCCESS;
   }
-  ++g_calls.emptied_submit;
-  g_calls.emptied.assign(submits, submits + count);
+  ++emptied_calls;
+  emptied.assign(submits, submits + count);
   g_calls.emptied_fence = fence;
   return VK_SUCCESS;
 }
+VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit(VkQueue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
+  return CountSubmission(count, submits, fence, &VkSubmitInfo::commandBufferCount, g_calls.queue_submit,
+                         g_calls.emptied_submit, g_calls.emptied);
+}
 VKAPI_ATTR VkResult VKAPI_CALL FakeQueueSubmit2(VkQueue, uint32_t count, const VkSubmitInfo2* submits, VkFence fence) {
-  uint32_t command_buffers = 0;
-  for (uint32_t i = 0; i < count; ++i) command_buffers += submits[i].commandBufferInfoCount;
-  if (command_buffers != 0 || count == 0) {
-    ++g_calls.queue_submit2;
-    return VK_SUCCESS;
-  }
-  ++g_calls.emptied_submit2;
-  g_calls.emptied2.assign(submits, submits + count);
-  g_calls.emptied_fence = fence;
-  return VK_SUCCESS;
+  return CountSubmission(count, submits, fence, &VkSubmitInfo2::commandBufferInfoCount, g_calls.queue_submit2,
+                         g_calls.emptied_submit2, g_calls.emptied2);
 }
 VKAPI_ATTR VkResult VKAPI_CALL FakeBegin(VkCommandBuffer, const VkCommandBufferBeginInfo*) { return VK_SUCCESS; }
 VKAPI_ATTR VkResult VKAPI_CALL FakeEnd(VkCommandBuffer) { return VK_SUCCESS; }
