@@ -31,6 +31,9 @@ struct DeviceDispatchTable {
   PFN_vkBindBufferMemory BindBufferMemory = nullptr;
   PFN_vkBindBufferMemory2 BindBufferMemory2 = nullptr;
   PFN_vkBuildAccelerationStructuresKHR BuildAccelerationStructuresKHR = nullptr;
+  PFN_vkCmdBeginRenderPass CmdBeginRenderPass = nullptr;
+  PFN_vkCmdBeginRenderPass2 CmdBeginRenderPass2 = nullptr;
+  PFN_vkCmdBeginRendering CmdBeginRendering = nullptr;
   PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR CmdBuildAccelerationStructuresIndirectKHR = nullptr;
   PFN_vkCmdBuildAccelerationStructuresKHR CmdBuildAccelerationStructuresKHR = nullptr;
@@ -41,6 +44,13 @@ struct DeviceDispatchTable {
   PFN_vkCmdDispatchBase CmdDispatchBase = nullptr;
   PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
   PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
+  PFN_vkCmdPipelineBarrier2 CmdPipelineBarrier2 = nullptr;
+  PFN_vkCmdResetEvent CmdResetEvent = nullptr;
+  PFN_vkCmdResetEvent2 CmdResetEvent2 = nullptr;
+  PFN_vkCmdSetEvent CmdSetEvent = nullptr;
+  PFN_vkCmdSetEvent2 CmdSetEvent2 = nullptr;
+  PFN_vkCmdWaitEvents CmdWaitEvents = nullptr;
+  PFN_vkCmdWaitEvents2 CmdWaitEvents2 = nullptr;
   PFN_vkCmdWriteAccelerationStructuresPropertiesKHR CmdWriteAccelerationStructuresPropertiesKHR = nullptr;
   PFN_vkCopyAccelerationStructureKHR CopyAccelerationStructureKHR = nullptr;
   PFN_vkCopyAccelerationStructureToMemoryKHR CopyAccelerationStructureToMemoryKHR = nullptr;

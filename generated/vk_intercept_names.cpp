@@ -13,6 +13,11 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkBindBufferMemory2",
     "vkBindBufferMemory2KHR",
     "vkBuildAccelerationStructuresKHR",
+    "vkCmdBeginRenderPass",
+    "vkCmdBeginRenderPass2",
+    "vkCmdBeginRenderPass2KHR",
+    "vkCmdBeginRendering",
+    "vkCmdBeginRenderingKHR",
     "vkCmdBindPipeline",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
     "vkCmdBuildAccelerationStructuresKHR",
@@ -20,6 +25,18 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdCopyAccelerationStructureToMemoryKHR",
     "vkCmdCopyMemoryToAccelerationStructureKHR",
     "vkCmdExecuteCommands",
+    "vkCmdPipelineBarrier",
+    "vkCmdPipelineBarrier2",
+    "vkCmdPipelineBarrier2KHR",
+    "vkCmdResetEvent",
+    "vkCmdResetEvent2",
+    "vkCmdResetEvent2KHR",
+    "vkCmdSetEvent",
+    "vkCmdSetEvent2",
+    "vkCmdSetEvent2KHR",
+    "vkCmdWaitEvents",
+    "vkCmdWaitEvents2",
+    "vkCmdWaitEvents2KHR",
     "vkCmdWriteAccelerationStructuresPropertiesKHR",
     "vkCopyAccelerationStructureKHR",
     "vkCopyAccelerationStructureToMemoryKHR",
@@ -82,6 +99,11 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkBindBufferMemory2
     true,  // vkBindBufferMemory2KHR
     true,  // vkBuildAccelerationStructuresKHR
+    true,  // vkCmdBeginRenderPass
+    true,  // vkCmdBeginRenderPass2
+    true,  // vkCmdBeginRenderPass2KHR
+    true,  // vkCmdBeginRendering
+    true,  // vkCmdBeginRenderingKHR
     true,  // vkCmdBindPipeline
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
     true,  // vkCmdBuildAccelerationStructuresKHR
@@ -89,6 +111,18 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdCopyAccelerationStructureToMemoryKHR
     true,  // vkCmdCopyMemoryToAccelerationStructureKHR
     true,  // vkCmdExecuteCommands
+    true,  // vkCmdPipelineBarrier
+    true,  // vkCmdPipelineBarrier2
+    true,  // vkCmdPipelineBarrier2KHR
+    true,  // vkCmdResetEvent
+    true,  // vkCmdResetEvent2
+    true,  // vkCmdResetEvent2KHR
+    true,  // vkCmdSetEvent
+    true,  // vkCmdSetEvent2
+    true,  // vkCmdSetEvent2KHR
+    true,  // vkCmdWaitEvents
+    true,  // vkCmdWaitEvents2
+    true,  // vkCmdWaitEvents2KHR
     true,  // vkCmdWriteAccelerationStructuresPropertiesKHR
     true,  // vkCopyAccelerationStructureKHR
     true,  // vkCopyAccelerationStructureToMemoryKHR

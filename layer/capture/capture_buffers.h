@@ -31,6 +31,7 @@ inline std::optional<AddressHit> BoundBufferCovering(const DeviceState& state, V
 // bytes from there the buffer of the app's holding the address has (at most what the source covers).
 struct CopySource {
   VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory aliased = VK_NULL_HANDLE;  // the memory `buffer` is the layer's alias of; null: the app's buffer
   VkDeviceSize offset = 0;
   VkDeviceSize bytes_left = 0;
 };
@@ -49,12 +50,13 @@ inline std::optional<CopySource> CopySourceIn(const DeviceState& state, MemoryAl
   if (alias->dedicated_to != VK_NULL_HANDLE) {
     // Only that buffer can be bound there; it is the only buffer whose addresses lie in it.
     if (alias->dedicated_to != b.handle || !b.capture_source) return std::nullopt;
-    return CopySource{b.handle, in_buffer, in_buffer_left};
+    return CopySource{b.handle, VK_NULL_HANDLE, in_buffer, in_buffer_left};
   }
   if (alias->buffer == VK_NULL_HANDLE || b.memory_offset > alias->size) return std::nullopt;
   const VkDeviceSize alias_left = alias->size - b.memory_offset;
   if (in_buffer > alias_left || size > alias_left - in_buffer) return std::nullopt;
-  return CopySource{alias->buffer, b.memory_offset + in_buffer, std::min(in_buffer_left, alias_left - in_buffer)};
+  return CopySource{alias->buffer, b.memory, b.memory_offset + in_buffer,
+                    std::min(in_buffer_left, alias_left - in_buffer)};
 }
 
 // The copy source of [address, address + size); nullopt with *why: no bound buffer of the app's covers the range

@@ -11,6 +11,7 @@
 #include "capture_buffers.h"
 #include "capture_plan.h"
 #include "capture_reduce_jobs.h"
+#include "capture_run_end.h"
 #include "failure_injection.h"
 #include "history.h"
 #include "structure_memory.h"
@@ -19,52 +20,16 @@ namespace asval {
 
 namespace {
 
-struct Copy {
-  VkBuffer src;
-  VkBuffer dst;
-  VkBufferCopy region;
-};
-
 // How the capture reads a geometry: copies of its ranges, the layer's dispatch reducing them in place, or (an array
 // of instance pointers) the dispatch gathering the pointers and the records they name.
 enum Stage : uint8_t { kCopied = 0, kReduced = 1, kGathered = 2 };
 
-// The captures of one command, between two barriers: copies, then the reducing dispatch (after which the app's
-// compute pipeline, `app_pipeline`, is bound again).
-void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies,
-                    const Dispatch& dispatch, VkPipeline app_pipeline) {
-  const bool reduces = dispatch.jobs != 0;
-  // Earlier writes of any kind (the app's own copies, fills, shaders) become visible to the transfer read (and to
-  // the layer's shader, which reads the inputs through their device addresses).
-  VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  before.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
-  before.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | (reduces ? VK_ACCESS_SHADER_READ_BIT : 0);
-  ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
-                              VK_PIPELINE_STAGE_TRANSFER_BIT | (reduces ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : 0), 0,
-                              1, &before, 0, nullptr, 0, nullptr);
-  for (const Copy& c : copies) ctx.next.CmdCopyBuffer(cb, c.src, c.dst, 1, &c.region);
-  if (reduces) {
-    ctx.next.CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, dispatch.pipeline);
-    ctx.next.CmdDispatchBase(cb, 0, dispatch.first_job % 32768, dispatch.first_job / 32768, dispatch.groups,
-                             dispatch.jobs, 1);
-    if (app_pipeline != VK_NULL_HANDLE) ctx.next.CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, app_pipeline);
-  }
-  // The copies (and the dispatch's writes) are visible to the host once the submission completes; later
-  // commands (writes of the inputs included) wait for the reads. Later writes into the same capture bytes (a
-  // command buffer executed twice: a secondary's next execution after the layer saved these bytes, capture_saves.h,
-  // or a primary listed twice, whose captures are then unknown) are ordered after these writes too: without them
-  // here they would race (a write-after-write hazard that synchronization validation reports).
-  VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | (reduces ? VK_ACCESS_SHADER_WRITE_BIT : 0);
-  after.dstAccessMask =
-      VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | (reduces ? VK_ACCESS_SHADER_WRITE_BIT : 0);
-  ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | (reduces ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : 0),
-                              VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after, 0, nullptr,
-                              0, nullptr);
-}
-
-void RecordCopies(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<Copy>& copies) {
-  RecordCaptures(ctx, cb, copies, Dispatch{}, VK_NULL_HANDLE);
+// The run's captures planned by this command are in the run: it is open until its capture point
+// (capture_run_end.h). The run's first copy notes the aliases' epoch (a source destroyed before the capture point
+// is left out there).
+void KeepOpen(const CaptureContext& ctx, CaptureRun& run, std::size_t copies_before) {
+  if (copies_before == 0 && !run.copies.empty()) run.aliases_epoch = ctx.aliases.Epoch();
+  if (!run.Empty()) run.Open(ctx.state.command_buffers.open_capture_runs());
 }
 
 // Room in the recording's slabs; false only when the pool could not give a slab (the device's memory, or the
@@ -154,7 +119,7 @@ void KeepRangeFacts(const VkAccelerationStructureBuildGeometryInfoKHR& info, uin
 
 }  // namespace
 
-bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& recording,
                            uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkDeviceAddress* addresses, const uint32_t* strides,
                            const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured) {
@@ -169,11 +134,11 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
   }
   try {
     InjectBadAlloc(FailSite::kCaptureRecord);
-    // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
-    thread_local std::vector<Copy> copies;
-    // No geometry data (only the range infos are captured): the facts their rules need.
+    // No geometry data (only the range infos are captured): the facts their rules need. Kept from call to call on
+    // this thread (nothing here calls back into the app): no allocation per call.
     thread_local std::vector<CapturedGeometry> planned;
-    copies.clear();
+    CaptureRun& run = recording.capture_run;
+    const std::size_t copies_before = run.copies.size();
     CommandCounts counts;
     for (uint32_t i = 0; i < info_count; ++i) {
       const uint32_t n = infos[i].geometryCount;
@@ -193,8 +158,9 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       const bool reserved = from && Reserve(ctx, log, bytes, &entry.ranges);
       if (from && !reserved) why = CaptureSkip::kCaptureMemoryFailed;
       if (reserved) {
-        copies.push_back(
-            Copy{from->buffer, log.BufferOf(entry.ranges), VkBufferCopy{from->offset, entry.ranges.offset, bytes}});
+        run.copies.push_back(CaptureCopy{from->buffer, log.BufferOf(entry.ranges),
+                                         VkBufferCopy{from->offset, entry.ranges.offset, bytes}, from->aliased,
+                                         static_cast<uint32_t>(log.infos.size())});
         ++counts.captured;
         counts.bytes += bytes;
       } else {
@@ -205,7 +171,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
       for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
       captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
     }
-    if (!copies.empty()) RecordCopies(ctx, cb, copies);
+    KeepOpen(ctx, run, copies_before);
     counts.AddTo(ctx.counters);
     return !captured.empty();
   } catch (const std::bad_alloc&) {
@@ -215,26 +181,29 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, Comman
 
 namespace {
 
-// CaptureBuildInputs, but an allocation failure throws (before anything is recorded into cb: the copies are
-// recorded last).
-bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+// CaptureBuildInputs, but an allocation failure throws (nothing is recorded into cb here: the run's capture point
+// records the copies and the dispatch).
+bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, CommandBufferState& recording,
                                uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                                const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                                std::vector<uint32_t>& captured) {
   InjectBadAlloc(FailSite::kCaptureRecord);
   // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
-  thread_local std::vector<Copy> copies;
   thread_local std::vector<CaptureSource> sources;
   thread_local std::vector<uint32_t> first_source;     // per geometry, and one past the last
   thread_local std::vector<uint8_t> reduced;           // per geometry: how it is captured (Stage)
   thread_local std::vector<CapturedGeometry> planned;  // the info's geometries, before they join the log
   thread_local std::vector<CommandDestination> destinations;
-  copies.clear();
+  // The copies and the jobs join the run's (capture_run.h), recorded at its capture point.
+  CaptureRun& run = recording.capture_run;
+  std::vector<CaptureCopy>& copies = run.copies;
+  const std::size_t copies_before = copies.size();
   CommandCounts counts;
-  // The layer's dispatch (capture_method reduce, or gathering arrays of instance pointers' records): one for the
-  // command, its jobs in one block, taken at the first capture that needs it.
-  JobBlock block;
+  // The layer's dispatch (capture_method reduce, or gathering arrays of instance pointers' records): the run's open
+  // job block, made sure at the command's first capture that needs it to have room for all of the command's jobs.
+  JobBlock& block = run.block;
   bool block_tried = !ctx.pool.dispatches();
+  bool use_block = false;
   bool destinations_logged = false;
   uint32_t first_destination = 0;
   for (uint32_t i = 0; i < info_count; ++i) {
@@ -284,7 +253,11 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
         if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
           ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
         }
-        block.Acquire(log, jobs, pipeline);
+        use_block = block.Room() >= jobs && block.dispatch.pipeline == pipeline;
+        if (!use_block) {  // a new block, larger each time a run outgrows one: a long run takes few dispatches
+          if (block.dispatch.jobs != 0) run.dispatches.push_back(block.dispatch);
+          use_block = AcquireJobs(block, log, jobs, std::max<uint32_t>(64, 2 * block.capacity), pipeline);
+        }
         block_tried = true;
       }
     }
@@ -292,12 +265,12 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     reduced.assign(first_source.size() - 1, kCopied);
     VkDeviceSize total = 0;
     for (std::size_t j = 0; j < reduced.size(); ++j) {
-      if (block.ok && ctx.pool.gathers() && Gatherable(planned[j]) && first_source[j + 1] == first_source[j] + 1) {
+      if (use_block && ctx.pool.gathers() && Gatherable(planned[j]) && first_source[j + 1] == first_source[j] + 1) {
         reduced[j] = kGathered;
         total = SaturatingAddBytes(total, GatheredCost(planned[j]));
         continue;
       }
-      reduced[j] = block.ok && ctx.pool.reduces() && Reducible(planned[j]) ? kReduced : kCopied;
+      reduced[j] = use_block && ctx.pool.reduces() && Reducible(planned[j]) ? kReduced : kCopied;
       if (reduced[j] == kReduced) {
         const ReducedSources of = SourcesOf(planned[j], sources.data() + first_source[j],
                                             sources.data() + first_source[j + 1]);
@@ -336,7 +309,9 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
           entry.complete = false;
           break;
         }
-        copies.push_back(Copy{from->buffer, log.BufferOf(*s.into), VkBufferCopy{from->offset, s.into->offset, s.size}});
+        copies.push_back(CaptureCopy{from->buffer, log.BufferOf(*s.into),
+                                     VkBufferCopy{from->offset, s.into->offset, s.size}, from->aliased,
+                                     static_cast<uint32_t>(log.infos.size())});
       }
     }
     if (!entry.complete) {
@@ -349,24 +324,24 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     }
     captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
-  if (!copies.empty() || block.dispatch.jobs != 0) {
-    RecordCaptures(ctx, cb, copies, block.dispatch, recording.compute_pipeline);
-  }
+  KeepOpen(ctx, run, copies_before);
   counts.AddTo(ctx.counters);
   return !captured.empty();
 }
 
 }  // namespace
 
-bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording,
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                         std::vector<uint32_t>& captured) {
   captured.clear();
   if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
   try {
-    return CaptureBuildInputsOrThrow(ctx, cb, recording, info_count, infos, ranges, captured);
+    return CaptureBuildInputsOrThrow(ctx, recording, info_count, infos, ranges, captured);
   } catch (const std::bad_alloc&) {
+    // What the run planned before the failure is still recorded at its capture point (nobody reads it).
+    KeepOpen(ctx, recording.capture_run, 1);
     uint64_t needing = 0;
     for (uint32_t i = 0; i < info_count; ++i) needing += NeedsCapture(ctx.mode, infos[i]);
     return CaptureDropped(ctx, needing, captured);
@@ -439,12 +414,17 @@ uint32_t CaptureSerializedBlobOrThrow(const CaptureContext& ctx, VkCommandBuffer
     ctx.counters.blobs_not_captured.fetch_add(1, std::memory_order_relaxed);
     return 0;
   }
-  // One copy: a single-element array of the thread's, as the builds' captures keep theirs (no allocation).
-  thread_local std::vector<Copy> copies;
+  // One copy: a single-element array of the thread's (no allocation per call), after the open run's captures (a
+  // serialization ends the run: blobs are rare next to builds).
+  thread_local std::vector<CaptureCopy> copies;
   copies.clear();
-  copies.push_back(Copy{from->buffer, log.BufferOf(into), VkBufferCopy{from->offset, into.offset, bytes}});
+  copies.push_back(CaptureCopy{from->buffer, log.BufferOf(into), VkBufferCopy{from->offset, into.offset, bytes},
+                               from->aliased, UINT32_MAX});
   const uint32_t blob = log.AddBlob(into);  // before the copy is recorded: it may allocate
-  RecordCopies(ctx, cb, copies);
+  static const std::vector<CaptureDispatch> kNoDispatch;
+  RecordCaptureRun(ctx, cb, recording);
+  RecordCaptures(ctx, cb, copies, kNoDispatch, VK_NULL_HANDLE);
+  ctx.counters.capture_points.fetch_add(1, std::memory_order_relaxed);
   ctx.counters.blobs_captured.fetch_add(1, std::memory_order_relaxed);
   ctx.counters.bytes_captured.fetch_add(bytes, std::memory_order_relaxed);
   return blob;

@@ -1,11 +1,10 @@
 #pragma once
 // Pre-record of a device build (execution-time capture, issue 12): decides which infos' inputs a rule needs at
-// execution time and records, through the next element of the chain and before the app's build, a barrier
-// that makes earlier writes visible to a transfer read, one copy per input range into the recording's capture
-// log, and a barrier that makes the copies visible to the host and keeps later writes behind the reads. Where the
-// capture reduces on the device (capture_method, capture_reducer.h), the geometries it can read in place get one
-// dispatch of the layer's per command instead of their copies (capture_reduce_jobs.h), the app's compute pipeline
-// bound again after it.
+// execution time and plans their capture into the recording's capture log: one copy per input range or, where the
+// capture reduces on the device (capture_method, capture_reducer.h), one job of the layer's dispatch per geometry it
+// can read in place (capture_reduce_jobs.h). The copies and the dispatch join the recording's open run of build
+// commands (capture_run.h) and are recorded into the command buffer where the run ends, between two barriers
+// (capture_run_end.h): N build commands in a row cost one capture point.
 //
 // Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
 // update's source: their activity record), updates, and every top-level build (its instance references); with
@@ -47,23 +46,23 @@ inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeo
   return mode == kCaptureAll || ActivityNeededForUpdates(info);
 }
 
-// vkCmdBuildAccelerationStructuresKHR: records the captures of the infos that need them into cb (whose state
-// is `recording`) and writes, per info, its index in recording.capture_log->infos plus one, or 0, into
+// vkCmdBuildAccelerationStructuresKHR: plans the captures of the infos that need them into `recording`'s run and
+// writes, per info, its index in recording.capture_log->infos plus one, or 0, into
 // `captured` (resized to info_count). False when nothing was captured (captured is then left empty).
-bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording,
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, std::vector<uint32_t>& captured);
 
-// vkCmdBuildAccelerationStructuresIndirectKHR: records the copies of every info's range infos (read by the device
+// vkCmdBuildAccelerationStructuresIndirectKHR: plans the copies of every info's range infos (read by the device
 // from pIndirectDeviceAddresses[i], pIndirectStrides[i] apart), keeping ppMaxPrimitiveCounts[i] with them, so that
 // the counts can be checked once the submission completes. `captured` as for CaptureBuildInputs.
-bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& recording,
                            uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkDeviceAddress* addresses, const uint32_t* strides,
                            const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured);
 
 // Device serialization (issue 12): the serialized bytes at `address` copied into the recording's capture log,
-// between the same two barriers as the builds' captures, so that a deserialization can be verified by content.
+// between the same two barriers as the builds' captures (after the open run's, which ends here), so that a deserialization can be verified by content.
 // vkCmdCopyAccelerationStructureToMemoryKHR: called AFTER the app's serialization was recorded (the copy captures
 // what it wrote; the first barrier makes its write visible), with `src` the serialized structure.
 // vkCmdCopyMemoryToAccelerationStructureKHR: called BEFORE the app's deserialization (what it will read), with src

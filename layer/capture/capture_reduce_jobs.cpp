@@ -62,27 +62,39 @@ bool Reducible(const CapturedGeometry& g) {
   }
 }
 
-bool JobBlock::Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline) {
+namespace {
+
+bool TakeBlock(JobBlock& block, CaptureLog& log, uint32_t jobs, VkPipeline pipeline) {
   CapturedBytes bytes;
-  if (pipeline == VK_NULL_HANDLE || jobs == 0 || jobs > kReduceMaxJobsPerDispatch ||
+  if (jobs == 0 || jobs > kReduceMaxJobsPerDispatch ||
       !log.Reserve(VkDeviceSize{jobs} * sizeof(ReduceJob) + 48, &bytes)) {  // 48: room to align to 64
     return false;
   }
   const VkDeviceSize first = (bytes.offset + 63) / 64;
   const uint32_t table_index = log.TableIndexOf(bytes);
   if (table_index == UINT32_MAX || first + jobs > kReduceJobsPerSlab) return false;
-  slots = log.WritableBytes(bytes) + (first * 64 - bytes.offset);
-  dispatch.pipeline = pipeline;
-  dispatch.first_job = table_index << 16 | static_cast<uint32_t>(first);
-  capacity = jobs;
-  return ok = true;
+  block.slots = log.WritableBytes(bytes) + (first * 64 - bytes.offset);
+  block.dispatch = CaptureDispatch{pipeline, table_index << 16 | static_cast<uint32_t>(first), 0, 0};
+  block.capacity = jobs;
+  return block.ok = true;
 }
 
-void JobBlock::Add(const ReduceJob& job) {
-  std::memcpy(slots + VkDeviceSize{dispatch.jobs} * sizeof(ReduceJob), &job, sizeof(job));
-  ++dispatch.jobs;
+}  // namespace
+
+bool AcquireJobs(JobBlock& block, CaptureLog& log, uint32_t jobs, uint32_t wanted, VkPipeline pipeline) {
+  block = JobBlock{};
+  if (pipeline == VK_NULL_HANDLE) return false;
+  wanted = std::min(std::max(wanted, jobs), kReduceMaxJobsPerDispatch);
+  // The larger block first; a slab's job table may have room for the jobs only.
+  return (wanted > jobs && TakeBlock(block, log, wanted, pipeline)) || TakeBlock(block, log, jobs, pipeline);
+}
+
+void AddJob(JobBlock& block, const ReduceJob& job) {
+  std::memcpy(block.slots + VkDeviceSize{block.dispatch.jobs} * sizeof(ReduceJob), &job, sizeof(job));
+  ++block.dispatch.jobs;
   const VkDeviceSize groups = (VkDeviceSize{job.count} + kReducePrimitivesPerGroup - 1) / kReducePrimitivesPerGroup;
-  dispatch.groups = std::max(dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
+  block.dispatch.groups =
+      std::max(block.dispatch.groups, static_cast<uint32_t>(std::min<VkDeviceSize>(groups, kReduceMaxGroups)));
 }
 
 bool Gatherable(const CapturedGeometry& g) {
@@ -109,7 +121,7 @@ bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedG
   const VkDeviceSize pointer_bytes = 8 * VkDeviceSize{g.range.primitiveCount};
   g.pointers = CapturedBytes{out.slab, out.offset, pointer_bytes, true};
   g.data = CapturedBytes{out.slab, out.offset + pointer_bytes, out.size - pointer_bytes, true};
-  block.Add(MakeReduceJob(g, pointers.address, 0, 0, log.AddressOf(out)));
+  AddJob(block, MakeReduceJob(g, pointers.address, 0, 0, log.AddressOf(out)));
   return true;
 }
 
@@ -158,7 +170,7 @@ bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry&
     g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
   }
   g.reduced = true;
-  block.Add(MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
+  AddJob(block, MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
                           transform ? transform->address : 0, log.AddressOf(out)));
   return true;
 }

@@ -10,31 +10,17 @@
 #include "capture_log.h"
 #include "capture_plan.h"
 #include "capture_reducer.h"
+#include "capture_run.h"
 #include "device_state.h"
 
 namespace asval {
 
-// The one reducing dispatch of a command (capture_reducer.h): its first job and how many follow it, and the X
-// groups the largest needs.
-struct Dispatch {
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  uint32_t first_job = 0;
-  uint32_t jobs = 0;
-  uint32_t groups = 0;
-};
-
-// The jobs of one command's reducing dispatch: a block in the recording's log, consecutive, in a slab the
-// reducer's table holds and within its first kReduceJobsPerSlab jobs.
-struct JobBlock {
-  bool ok = false;
-  uint8_t* slots = nullptr;
-  Dispatch dispatch;
-  uint32_t capacity = 0;
-  // Room for `capacity` jobs and the pipeline; false (the command's captures are then copied) when either is
-  // missing.
-  bool Acquire(CaptureLog& log, uint32_t jobs, VkPipeline pipeline);
-  void Add(const ReduceJob& job);
-};
+// Room for `jobs` more jobs in `block` (capture_run.h) and the pipeline: the block is taken anew in the recording's
+// log, for at least `jobs` and, where the log has room, for `wanted` (a run's later commands then add theirs to the
+// same dispatch). False (the captures are then copied) when the pipeline is missing or the log has no room; the
+// block's jobs so far must have been moved out first (its dispatch recorded or kept by the run).
+bool AcquireJobs(JobBlock& block, CaptureLog& log, uint32_t jobs, uint32_t wanted, VkPipeline pipeline);
+void AddJob(JobBlock& block, const ReduceJob& job);
 
 // Whether geometry g's bytes (its `data`) can be reduced on the device instead of copied: triangles, AABBs, and
 // instances given as an array of records, with strides the shader's 32-bit arithmetic holds.

@@ -94,6 +94,7 @@ void MemoryAliases::Forget(VkDeviceMemory memory) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::optional<std::shared_ptr<const MemoryAlias>> alias = aliases_.pop(memory);
   if (!alias || !*alias || (*alias)->buffer == VK_NULL_HANDLE) return;
+  epoch_.fetch_add(1, std::memory_order_acq_rel);
   next_.DestroyBuffer(device_, (*alias)->buffer, nullptr);
   --live_;
 }

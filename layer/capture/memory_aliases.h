@@ -49,8 +49,19 @@ class MemoryAliases {
   // The alias record of `memory`, made now when there is none; null when the memory is unknown to the layer (or
   // being freed) or the record could not be allocated.
   std::shared_ptr<const MemoryAlias> Of(const DeviceState& state, VkDeviceMemory memory);
+  // The alias record of `memory` if one was made (none is made here).
+  std::shared_ptr<const MemoryAlias> Find(VkDeviceMemory memory) const {
+    std::optional<std::shared_ptr<const MemoryAlias>> found = aliases_.find(memory);
+    return found ? std::move(*found) : nullptr;
+  }
   // vkFreeMemory, before the downcall and after the shadow state forgot the memory: its alias is destroyed.
   void Forget(VkDeviceMemory memory);
+  // vkDestroyBuffer: a dedicated allocation's buffer, which copies name, may be gone.
+  void BufferDestroyed() { epoch_.fetch_add(1, std::memory_order_acq_rel); }
+  // Changes each time a buffer a copy may name can have been destroyed (Forget, BufferDestroyed): a copy planned
+  // at one epoch still names live buffers while the epoch reads the same (capture_run.h: the copies of a run are
+  // recorded after the build commands that planned them).
+  uint64_t Epoch() const { return epoch_.load(std::memory_order_acquire); }
   // vkDestroyDevice: every alias destroyed; none made afterwards.
   void Shutdown();
   // Aliases alive (buffers of the layer's), for the footprint and the tests' reasoning.
@@ -71,6 +82,7 @@ class MemoryAliases {
   std::size_t live_ = 0;
   bool shut_down_ = false;
   std::atomic<uint64_t> failures_{0};
+  std::atomic<uint64_t> epoch_{0};
 };
 
 }  // namespace asval

@@ -149,11 +149,13 @@ void ReportHistorySummary(const DeviceState& state, Reporter& reporter, VkDevice
     const std::string text =
         fmt::format("Execution-time capture: {} build infos captured ({} bytes), {} updates judged on their captured "
                     "activity; {} infos that a rule needed could not be captured{}{} (their rules were skipped and "
-                    "counted; docs/capture.md says what each reason means).",
+                    "counted; docs/capture.md says what each reason means). The captures were recorded at {} capture "
+                    "points (one per run of build commands and one per serialized blob).",
                     capture.infos_captured.load(std::memory_order_relaxed),
                     capture.bytes_captured.load(std::memory_order_relaxed),
                     capture.updates_compared.load(std::memory_order_relaxed), not_captured,
-                    not_captured != 0 ? ":" : "", named);
+                    not_captured != 0 ? ":" : "", named,
+                    capture.capture_points.load(std::memory_order_relaxed));
     const NamedCounts counts{kCaptureSkippedField, reasons.data(), reasons.size()};
     const Location where("vkDestroyDevice");
     // What went unchecked reaches the report file (the gate) even when report_flags leaves info out.

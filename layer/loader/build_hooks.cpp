@@ -14,7 +14,8 @@ namespace asval::hooks {
 
 namespace {
 
-// Pre-record: the copies of what the infos that need it read, recorded before the build (layer/capture). Returns
+// Pre-record: the captures of what the infos that need it read, planned into the command buffer's run of build
+// commands and recorded where the run ends (layer/capture, capture_run.h). Returns
 // per info its capture index plus one (0: none), or null when the call captures nothing: the common static
 // build costs one flag test per info.
 const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t info_count,
@@ -29,7 +30,7 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
   const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
   if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown
   const bool any_captured =
-      CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured);
+      CaptureBuildInputs(MakeCaptureContext(data), *recording, info_count, infos, ranges, captured);
   ReportCaptureBudget(MakeCheckContext(data), data.instance->settings.capture_budget_mb,
                       "vkCmdBuildAccelerationStructuresKHR");
   return any_captured ? captured.data() : nullptr;
@@ -77,12 +78,12 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   if (ValidateBuildCommand(MakeCheckContext(*data), cmd, thread.data())) {
     return WithholdRecordedCommand(*data, cmd.function, commandBuffer, protect);
   }
-  // Pre-record: the range infos the device will read, copied when the build executes (layer/capture).
+  // Pre-record: the range infos the device reads, copied at the run's capture point (layer/capture).
   const uint32_t* captured = nullptr;
   if (data->capture_tracker) {
     if (const std::shared_ptr<CommandBufferState> recording = data->state.command_buffers.Find(commandBuffer)) {
       std::vector<uint32_t>& out = thread.data().captured_infos;
-      if (CaptureIndirectRanges(MakeCaptureContext(*data), commandBuffer, *recording, infoCount, pInfos,
+      if (CaptureIndirectRanges(MakeCaptureContext(*data), *recording, infoCount, pInfos,
                                 pIndirectDeviceAddresses, pIndirectStrides, ppMaxPrimitiveCounts, out)) {
         captured = out.data();
       }

@@ -66,6 +66,7 @@ VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer commandBuffer,
 
 VKAPI_ATTR VkResult VKAPI_CALL EndCommandBuffer(VkCommandBuffer commandBuffer) {
   DeviceData* data = GetDeviceData(commandBuffer);
+  EndCaptureRun(*data, commandBuffer);  // the run's captures are the recording's last commands
   const VkResult result = data->dispatch.EndCommandBuffer(commandBuffer);
   if (result == VK_SUCCESS) data->state.command_buffers.End(commandBuffer);
   return result;
@@ -81,6 +82,7 @@ VKAPI_ATTR VkResult VKAPI_CALL ResetCommandBuffer(VkCommandBuffer commandBuffer,
 VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uint32_t commandBufferCount,
                                               const VkCommandBuffer* pCommandBuffers) {
   DeviceData* data = GetDeviceData(commandBuffer);
+  EndCaptureRun(*data, commandBuffer);  // the secondaries may hold barriers
   if (!data->capture_pool || !pCommandBuffers) {
     data->dispatch.CmdExecuteCommands(commandBuffer, commandBufferCount, pCommandBuffers);
     RecordExecuteCommands(data->state, commandBuffer, commandBufferCount, pCommandBuffers);

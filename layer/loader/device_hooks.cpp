@@ -101,6 +101,7 @@ VKAPI_ATTR void VKAPI_CALL GetDeviceBufferMemoryRequirements(VkDevice device,
 VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice device, VkBuffer buffer, const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
   if (buffer) RecordDestroyBuffer(data->state, buffer);
+  if (buffer && data->capture_aliases) data->capture_aliases->BufferDestroyed();
   data->dispatch.DestroyBuffer(device, buffer, pAllocator);
 }
 

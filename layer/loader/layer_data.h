@@ -8,6 +8,7 @@
 
 #include "capture_pool.h"
 #include "capture_recorder.h"
+#include "capture_run_end.h"
 #include "capture_tracker.h"
 #include "check_context.h"
 #include "device_state.h"
@@ -48,6 +49,16 @@ inline CaptureContext MakeCaptureContext(DeviceData& data) {
   const LayerSettings& settings = data.instance->settings;
   return CaptureContext{data.state, data.dispatch, *data.capture_pool, *data.capture_aliases, settings.capture,
                         VkDeviceSize{settings.capture_budget_mb} << 20, data.state.capture_counters};
+}
+
+// The end of a run of build commands in cb (layer/state/capture_run.h): its captures recorded into cb now
+// (capture_run_end.h), before the command that ends it goes down. One load while no command buffer of the device
+// holds an open run.
+inline void EndCaptureRun(DeviceData& data, VkCommandBuffer cb) {
+  if (!data.capture_tracker || !data.state.command_buffers.AnyOpenCaptureRun()) return;
+  if (const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb)) {
+    RecordCaptureRun(MakeCaptureContext(data), cb, *recording);
+  }
 }
 
 // Processes the submissions with captures that completed (or that `covered` names: the app's wait saw them

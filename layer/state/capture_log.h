@@ -41,6 +41,9 @@ struct CaptureCounters {
     for (const std::atomic<uint64_t>& n : infos_not_captured) total += n.load(std::memory_order_relaxed);
     return total;
   }
+  // The points in command buffers where captures were recorded: one per run of build commands (capture_run.h) and
+  // one per serialized blob.
+  std::atomic<uint64_t> capture_points{0};
   // Updates whose activity rules (03663/03664/03768) were judged on captured bytes.
   std::atomic<uint64_t> updates_compared{0};
   // Device serialization bytes (vkCmdCopyAccelerationStructureToMemoryKHR's written, vkCmdCopyMemoryTo...'s read):

@@ -27,6 +27,7 @@ void CommandBufferState::Reset() {
   recording_lost = false;
   secondaries.clear();
   capture_log.reset();  // a submission still reading it keeps it
+  capture_run.Close();  // its reservations were in that log
   executed_capture_logs.clear();
   compute_pipeline = VK_NULL_HANDLE;
   calls_.fill(0);
@@ -147,6 +148,7 @@ void CommandBufferMap::Free(uint32_t count, const VkCommandBuffer* buffers) {
     if (!buffers[i]) continue;  // freeing VK_NULL_HANDLE is allowed and does nothing
     std::optional<std::shared_ptr<CommandBufferState>> state = buffers_.pop(buffers[i]);
     if (!state || !*state) continue;
+    (*state)->capture_run.Close();
     if (std::shared_ptr<PoolState> pool = PoolOf((*state)->pool)) {
       auto& list = pool->buffers;
       auto it = std::find(list.begin(), list.end(), buffers[i]);

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "capture_log.h"
+#include "capture_run.h"
 #include "command_buffer_ops.h"
 #include "concurrent_map.h"
 #include "protect_marks.h"
@@ -56,6 +57,9 @@ class CommandBufferState {
   // secondaries' recordings.
   std::shared_ptr<CaptureLog> capture_log;
   std::vector<std::shared_ptr<CaptureLog>> executed_capture_logs;
+  // The captures planned into capture_log by the build commands since the last capture point, not yet recorded
+  // (capture_run.h).
+  CaptureRun capture_run;
   // The app's compute pipeline bound now (tracked only where the capture reduces on the device): bound again
   // after the layer's reducing dispatch. Null: none bound yet in this recording, or the binding became undefined
   // (vkCmdExecuteCommands).
@@ -111,7 +115,9 @@ class CommandBufferMap {
     std::optional<std::shared_ptr<PoolState>> record = pools_.pop(pool);
     if (!record || !*record) return;
     for (VkCommandBuffer cb : (*record)->buffers) {
-      buffers_.erase(cb);
+      if (std::optional<std::shared_ptr<CommandBufferState>> state = buffers_.pop(cb); state && *state) {
+        (*state)->capture_run.Close();
+      }
       freed(cb);
     }
   }
@@ -153,6 +159,10 @@ class CommandBufferMap {
   // same, a CommandBufferState found before is still the one the map holds (history_recorder.cpp keeps the
   // last one it recorded into).
   StampValue stamp() const { return buffers_.stamp(); }
+  // How many command buffers hold a run of build commands whose captures are not recorded yet (capture_run.h):
+  // while none does, the commands that end a run look up no command buffer.
+  std::atomic<uint32_t>& open_capture_runs() const { return open_capture_runs_; }
+  bool AnyOpenCaptureRun() const { return open_capture_runs_.load(std::memory_order_acquire) != 0; }
 
  private:
   struct PoolState {
@@ -165,6 +175,7 @@ class CommandBufferMap {
   void CountUntracked(uint32_t count) const;
 
   FailureCounters* failures_ = nullptr;
+  mutable std::atomic<uint32_t> open_capture_runs_{0};  // before buffers_: outlives every state the map holds
   ConcurrentMap<VkCommandBuffer, std::shared_ptr<CommandBufferState>, 6> buffers_;
   ConcurrentMap<VkCommandPool, std::shared_ptr<PoolState>> pools_;
   std::atomic<bool> any_protected_pool_{false};
