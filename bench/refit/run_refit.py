@@ -10,8 +10,7 @@ submit+wait, GPU time from timestamps, frame time) with frame and GPU time again
 structures of 256 triangles as 100 calls unless told otherwise), and the ratio of what asval adds at default
 settings to what it adds with capture off (the issue's lavapipe target: at most 2).
 --smoke: CI's quick mode (N 1 and 10, 64 triangles, 3 frames, one round, no timing asserted), then one run of
-each shape under asval with capture=all whose JSON report must hold no error or warning, and (if installed) under
-the Khronos layer with synchronization validation, which must report nothing.
+each shape under asval with capture=all whose JSON report must hold no error or warning.
 docs/performance.md ("Heavy-refit frames") has the commands and figures.
 """
 
@@ -35,11 +34,6 @@ from refit_runs import Case, RunError, report, run_callgrind, run_frames, valgri
 
 REPO = os.path.dirname(os.path.dirname(HERE))
 Config = overhead_env.Config
-KHRONOS_MANIFEST = os.path.join(overhead_env.SYSTEM_LAYER_DIR, "VkLayer_khronos_validation.json")
-
-
-def khronos_installed() -> bool:
-    return os.path.exists(KHRONOS_MANIFEST)
 
 
 def parse_args(argv: List[str]) -> argparse.Namespace:
@@ -78,12 +72,13 @@ def configurations(args: argparse.Namespace) -> List[Config]:
     configs = [Config("none", {}),
                Config("asval", {"VK_INSTANCE_LAYERS": asval}),  # defaults: capture=updates, capture_method=auto
                Config("asval-capture-off", {"VK_INSTANCE_LAYERS": asval, "VK_ASVAL_AS_VALIDATION_CAPTURE": "off"})]
+    khronos_manifest = os.path.join(overhead_env.SYSTEM_LAYER_DIR, "VkLayer_khronos_validation.json")
     if args.callgrind:
         pass  # the issue's target compares asval with itself
-    elif khronos_installed():
+    elif os.path.exists(khronos_manifest):
         configs.append(Config("khronos", {"VK_INSTANCE_LAYERS": overhead_env.KHRONOS}))
     else:
-        print(f"run_refit: {KHRONOS_MANIFEST} not found: no Khronos row", file=sys.stderr)
+        print(f"run_refit: {khronos_manifest} not found: no Khronos row", file=sys.stderr)
     if args.configs:
         wanted = [c.strip() for c in args.configs.split(",") if c.strip()]
         unknown = [w for w in wanted if w not in [c.name for c in configs]]
@@ -164,26 +159,7 @@ def check_valid(args, all_cases, base_env) -> int:
         if not re.search(r"[1-9][0-9]* updates judged", message) or skipped:
             print("  the capture judged no update, or skipped an input a rule needed: the check proves nothing")
             failed += 1
-        if khronos_installed():
-            check_synchronization(args, case, base_env)
     return failed
-
-
-def check_synchronization(args, case: Case, base_env) -> None:
-    """The Khronos layer with its synchronization validation, without asval: the benchmark's own barriers (the
-    compute writes before the refits read, the refits before the top level) are right. Any message fails the run
-    (RunError)."""
-    folder = os.path.join(base_env["HOME"], "khronos-sync")
-    os.makedirs(folder, exist_ok=True)
-    settings = os.path.join(folder, "vk_layer_settings.txt")
-    with open(settings, "w") as f:
-        f.write("khronos_validation.enables = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT\n")
-    env = overhead_env.environment(base_env, Config("khronos-sync", {"VK_INSTANCE_LAYERS": overhead_env.KHRONOS,
-                                                                      "VK_LAYER_SETTINGS_PATH": settings}))
-    if "ASAN_OPTIONS" in env:  # that layer's synchronization validation leaks at exit (tests/integration/CMakeLists.txt)
-        env["ASAN_OPTIONS"] += ":detect_leaks=0"
-    run_frames(case.argv(program(args), args.frames, args.warmup), env, tolerate=False)
-    print(f"validity, {case.name}, Khronos layer with synchronization validation: no message")
 
 
 def write_json(path, args, argv, configs, driver, samples=None, notes=None, ir=None) -> None:
