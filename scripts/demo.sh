@@ -88,3 +88,17 @@ print("(docs/coverage.md lists what is checked). The scene's image: %s" % os.pat
 print("withheld: what asval's protect mode kept from the driver (cmd: the command; submit: a submission; halt: the")
 print("fault ran, found when it completed, so later submissions are withheld; docs/protect.md).")
 PY
+
+# The scene refits 2 structures per frame; engines refit hundreds (skinned characters, deforming props), often one
+# build command each. --refits adds that load (docs/scene.md); asval must still report nothing, and the frame rates
+# show what the layer costs there (bench/refit measures it properly: docs/performance.md, "Heavy-refit frames").
+echo
+echo "== 3. A heavy-refit frame: 200 more structures refit per frame, one build command each =="
+fps() { grep -o 'frames 1\.\.[0-9]* (refits) [0-9.]* fps' "$1" | awk '{print $4}'; }
+"$scene" --frames 6 --size 64x64 --refits 200 >"$out/refits-none.log" 2>&1
+if ! scripts/asval-run --report "$out/refits.jsonl" -- "$scene" --frames 6 --size 64x64 --refits 200 \
+    >"$out/refits-asval.log" 2>&1; then
+  echo "demo: the heavy-refit scene did not pass the gate (see $out/refits-asval.log)" >&2
+  exit 1
+fi
+echo "  without a layer: $(fps "$out/refits-none.log") fps; under asval (passed the gate): $(fps "$out/refits-asval.log") fps"

@@ -62,6 +62,10 @@ int Run(const scene::SceneOptions& options) {
                   static_cast<unsigned long long>(world.statics.compacted_bytes()));
       std::printf("deforming: %u inactive triangles (NaN), %u degenerate at the first build\n",
                   world.deforming.meshes().inactive_triangles, world.deforming.meshes().degenerate_triangles);
+      if (world.crowd.count()) {
+        std::printf("crowd: %u more bottom-level structures refit per frame, one vkCmdBuildAccelerationStructuresKHR each\n",
+                    world.crowd.count());
+      }
       std::fflush(stdout);
       FrameCheckpointsHook checkpoints(world, options);
       world.RunFrames();

@@ -44,7 +44,7 @@ bool Fail(std::string* error, std::string message) {
 
 const char* Usage() {
   return "usage: asval_scene [--frames N] [--instances N] [--size WxH] [--static] [--out FILE.png] [--inject FAULT]\n"
-         "                   [--checkpoints N,N,...]\n"
+         "                   [--checkpoints N,N,...] [--refits N]\n"
          "       asval_scene --list-faults\n"
          "Renders an animated ray-traced scene without a window (any device with VK_KHR_acceleration_structure\n"
          "and VK_KHR_ray_tracing_pipeline). Layers come from the environment (VK_INSTANCE_LAYERS).\n"
@@ -58,6 +58,9 @@ const char* Usage() {
          "                  setting on (VkLayerSettingsCreateInfoEXT)\n"
          "  --checkpoints N,N,...  after each of these frame counts, print the process's resident memory (now and\n"
          "                  peak) and the wall time per frame of the 100 frames before (bench/longrun)\n"
+         "  --refits N      refit N more bottom-level structures every frame (copies of the blob, not traced), each\n"
+         "                  with its own vkCmdBuildAccelerationStructuresKHR, as engines refit many deforming\n"
+         "                  objects (default 0)\n"
          "  --list-faults   print each fault with the VUID it must trigger\n";
 }
 
@@ -75,6 +78,8 @@ bool ParseOptions(int argc, char** argv, SceneOptions* o, std::string* error) {
       if (!ParseCount(argv[++i], 1, 100000, &o->frames)) return Fail(error, "--frames: expected 1..100000");
     } else if (std::strcmp(a, "--instances") == 0 && has_value) {
       if (!ParseCount(argv[++i], 2, 1000000, &o->instances)) return Fail(error, "--instances: expected 2..1000000");
+    } else if (std::strcmp(a, "--refits") == 0 && has_value) {
+      if (!ParseCount(argv[++i], 0, 100000, &o->refits)) return Fail(error, "--refits: expected 0..100000");
     } else if (std::strcmp(a, "--size") == 0 && has_value) {
       const std::string s = argv[++i];
       const size_t x = s.find('x');

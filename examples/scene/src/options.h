@@ -11,6 +11,7 @@ struct FaultInfo;
 struct SceneOptions {
   uint32_t frames = 4;
   uint32_t instances = 2000;
+  uint32_t refits = 0;  // --refits: extra structures refit per frame, one call each
   uint32_t width = 256;
   uint32_t height = 256;
   std::string out;                   // PNG path; empty: no image written

@@ -29,7 +29,8 @@ Scene::Scene(Gpu& g, Findings& f, const SceneOptions& o)
       deforming(g),
       top(g, o.instances, Prototype{statics.structure(StaticBlases::kGround).address, 0, 1.0f, 0},
           Prototypes(statics, deforming)),
-      tracer(g, o.width, o.height) {
+      tracer(g, o.width, o.height),
+      crowd(g, deforming, o.refits) {
   tracer.SetScene(top.structure().handle);
   const float eye[3] = {1.5f, 4.5f, 12.0f};
   const float target[3] = {0.0f, 0.8f, 0.0f};
@@ -61,6 +62,7 @@ void Scene::RecordCommandBuffers() {
     refit_[p] = Record(0, [&](VkCommandBuffer cb) {
       deforming.RecordAnimate(cb, p);
       deforming.RecordBuilds(cb, p, kUpdate);
+      crowd.RecordBuilds(cb, p, kUpdate);
     });
     tlas_update_[p] = Record(0, [&](VkCommandBuffer cb) { top.RecordBuild(cb, p, kUpdate); });
     tlas_build_[p] = Record(0, [&](VkCommandBuffer cb) { top.RecordBuild(cb, p, kBuild); });
@@ -70,6 +72,7 @@ void Scene::RecordCommandBuffers() {
   first_ = Record(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT, [&](VkCommandBuffer cb) {
     deforming.RecordAnimate(cb, 0);
     deforming.RecordBuilds(cb, 0, kBuild);
+    crowd.RecordBuilds(cb, 0, kBuild);
   });
   const char* names[] = {"refit (even frames)", "refit (odd frames)", "TLAS update (even frames)",
                          "TLAS update (odd frames)", "TLAS build (even frames)", "TLAS build (odd frames)"};

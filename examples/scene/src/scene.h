@@ -1,6 +1,7 @@
 #pragma once
 // The scene: its parts, the command buffers it reuses every frame, and the frame loop. A frame is one
-// submission of three command buffers: animate + refit the deforming structures (or, in frame 0, build them),
+// submission of three command buffers: animate + refit the deforming structures, and the --refits crowd (or, in
+// frame 0, build them),
 // update (every 4th frame: rebuild) the top-level structure, trace. With --static, frames after frame 0 only
 // trace.
 //
@@ -11,6 +12,7 @@
 #include <functional>
 #include <string>
 
+#include "crowd_blases.h"
 #include "deforming_blases.h"
 #include "findings.h"
 #include "gpu.h"
@@ -47,6 +49,7 @@ class Scene {
   DeformingBlases deforming;
   TopLevel top;
   RayTracer tracer;
+  CrowdBlases crowd;  // --refits N: N more structures refit per frame, one call each (none by default)
 
  private:
   void RecordCommandBuffers();
