@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "capture_helpers.h"
+#include "capture_skipped.h"
 #include "history_helpers.h"
 #include "temp_report.h"
 
@@ -73,6 +74,9 @@ class RunRig {
     return event_;
   }
   Blas& structure(uint32_t i) { return *structures_[i]; }
+
+  // Destroys structure i's inputs buffer and frees its memory (the structure must not be built from them again).
+  void DropInputs(uint32_t i) { inputs_[i].reset(); }
 
   void Fill(VkCommandBuffer cb, uint32_t i, VkDeviceSize offset, uint32_t word) {
     vkCmdFillBuffer(cb, inputs_[i]->buffer().buffer, offset, sizeof(uint32_t), word);
@@ -275,6 +279,32 @@ TEST_CASE("capture run: build commands in a row take one capture point; separate
   }
   f.Close();
   CHECK(CapturePoints(report) == 6);
+}
+
+TEST_CASE("capture run: memory freed while the run is open: its copies are left out and counted, no destroyed buffer "
+          "is named",
+          "[integration][capture][passes-invalid-down]") {
+  // An app that goes on recording a command buffer made invalid by the free (invalid itself, and the Khronos layer
+  // says so: hence the tag, which keeps the Khronos runs out; such a recording can only be reset or freed) must not
+  // make the layer name the buffer that went with the memory. Only the copy method names buffers (the reduced
+  // capture reads through addresses; the environment of integration_capture_reduce forces it, though that run
+  // leaves this test out).
+  asval_test_common::TempReport report;
+  HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}, {"report_flags", "error,warn,info"},
+                             {"capture_method", "copy"}});
+  {
+    RunRig rig(f, 1);
+    rig.BuildAll();
+    VkCommandBuffer cb = rig.commands().Begin();
+    rig.structure(0).Update(cb, Triangles());  // its copy reads the layer's buffer over the inputs' memory
+    rig.DropInputs(0);                         // that buffer goes with the memory: the recording can never be submitted
+    rig.commands().End(cb);                    // the run's capture point
+    CHECK(f.monitor().Verify() == "");
+  }
+  f.Close();
+  const std::map<std::string, uint64_t> expected =
+      CaptureReducedRun() ? std::map<std::string, uint64_t>{} : std::map<std::string, uint64_t>{{"unknown_address", 1}};
+  CHECK(asval_test_common::ReadCaptureSkipped(report.Lines()).NonZero() == expected);
 }
 
 }  // namespace
