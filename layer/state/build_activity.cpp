@@ -106,7 +106,7 @@ bool Classify(const CaptureLog& log, const CapturedGeometry& g, builder::Activit
   builder::ClassifyResult result;
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     if (g.index_type != VK_INDEX_TYPE_NONE_KHR && !g.indices.present) return false;
-    result = builder::ClassifyTriangles(TriangleView(log, g), record, nullptr);
+    result = builder::ClassifyTriangles(TriangleView(log, g), record, nullptr, builder::ClassifyDetail::kActivity);
   } else if (g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
     // Arrays of pointers: their records, gathered, read as a plain array's (the same records give the same bits,
     // so an update compares with its source whichever layout each used); a record not followed is unknown.

@@ -334,9 +334,142 @@ uint64_t ReadableElements(uint64_t bytes, uint64_t offset, uint64_t elementBytes
     return (bytes - offset - elementBytes) / stride + 1;
 }
 
+// Activity only (ClassifyDetail::kActivity): whether every triangle of the range is readable and no vertex any
+// of them can read holds a NaN in X, Y or Z, so that each is active with defined input and the per-triangle loop
+// can be skipped. Reads the indices once (their smallest and largest value) and the vertices between those
+// once, instead of three vertices per triangle. False (the loop decides) whenever that is not certain, and when
+// the vertices between would outnumber the triangles' three (a sparse range of a large shared buffer).
+template <typename IndexT>
+void IndexRange(const uint8_t* indices, uint64_t count, uint64_t* lo, uint64_t* hi) {
+    uint32_t mn = UINT32_MAX, mx = 0;
+    for (uint64_t i = 0; i < count; ++i) {
+        const uint32_t v = uint32_t(LoadIndex<IndexT>(indices, i));
+        mn = v < mn ? v : mn;
+        mx = v > mx ? v : mx;
+    }
+    *lo = mn;
+    *hi = mx;
+}
+
+// The same for 32-bit indices, four at a time (SSE2 compares are signed: the values are biased by the sign bit),
+// the rest one at a time.
+template <>
+void IndexRange<uint32_t>(const uint8_t* indices, uint64_t count, uint64_t* lo, uint64_t* hi) {
+    const __m128i bias = _mm_set1_epi32(INT32_MIN);
+    __m128i mn = _mm_set1_epi32(INT32_MAX), mx = bias;  // UINT32_MAX and 0, biased
+    uint64_t i = 0;
+    for (; i + 4 <= count; i += 4) {
+        const __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(indices + 4 * i)), bias);
+        const __m128i below = _mm_cmplt_epi32(v, mn), above = _mm_cmpgt_epi32(v, mx);
+        mn = _mm_or_si128(_mm_and_si128(below, v), _mm_andnot_si128(below, mn));
+        mx = _mm_or_si128(_mm_and_si128(above, v), _mm_andnot_si128(above, mx));
+    }
+    uint32_t lanesMn[4], lanesMx[4];
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lanesMn), _mm_xor_si128(mn, bias));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lanesMx), _mm_xor_si128(mx, bias));
+    IndexRange<uint8_t>(nullptr, 0, lo, hi);  // the empty range: lo UINT32_MAX, hi 0
+    for (int k = 0; k < 4; ++k) {
+        *lo = std::min<uint64_t>(*lo, lanesMn[k]);
+        *hi = std::max<uint64_t>(*hi, lanesMx[k]);
+    }
+    for (; i < count; ++i) {
+        *lo = std::min<uint64_t>(*lo, LoadU32(indices + 4 * i));
+        *hi = std::max<uint64_t>(*hi, LoadU32(indices + 4 * i));
+    }
+}
+
+// 16-bit indices eight at a time, biased as above.
+template <>
+void IndexRange<uint16_t>(const uint8_t* indices, uint64_t count, uint64_t* lo, uint64_t* hi) {
+    const __m128i bias = _mm_set1_epi16(INT16_MIN);
+    __m128i mn = _mm_set1_epi16(INT16_MAX), mx = bias;
+    uint64_t i = 0;
+    for (; i + 8 <= count; i += 8) {
+        const __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(indices + 2 * i)), bias);
+        mn = _mm_min_epi16(mn, v);
+        mx = _mm_max_epi16(mx, v);
+    }
+    uint16_t lanesMn[8], lanesMx[8];
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lanesMn), _mm_xor_si128(mn, bias));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(lanesMx), _mm_xor_si128(mx, bias));
+    IndexRange<uint8_t>(nullptr, 0, lo, hi);
+    for (int k = 0; k < 8; ++k) {
+        *lo = std::min<uint64_t>(*lo, lanesMn[k]);
+        *hi = std::max<uint64_t>(*hi, lanesMx[k]);
+    }
+    for (; i < count; ++i) {
+        *lo = std::min<uint64_t>(*lo, LoadU16(indices + 2 * i));
+        *hi = std::max<uint64_t>(*hi, LoadU16(indices + 2 * i));
+    }
+}
+
+// Whether a component of vertices first..last, up to Z, is NaN (each vertex read at `stride`). Word is the
+// component's bits (uint32_t: float32, uint16_t: float16).
+template <typename Word, unsigned Components>
+bool AnyNaN(const uint8_t* vertices, uint64_t stride, uint64_t first, uint64_t last) {
+    constexpr Word kMagnitude = sizeof(Word) == 4 ? Word(0x7FFFFFFFu) : Word(0x7FFFu);
+    constexpr Word kInfinity = sizeof(Word) == 4 ? Word(0x7F800000u) : Word(0x7C00u);
+    const uint8_t* from = vertices + first * stride;
+    if (stride % sizeof(Word) != 0 || stride > 16) {
+        Word largest = 0;  // the largest magnitude bits: NaN iff above infinity's
+        for (uint64_t v = first; v <= last; ++v) {
+            for (unsigned c = 0; c < Components; ++c) {
+                Word w;
+                std::memcpy(&w, vertices + v * stride + sizeof(Word) * c, sizeof(Word));
+                w &= kMagnitude;
+                largest = w > largest ? w : largest;
+            }
+        }
+        return largest > kInfinity;
+    }
+    // Vertices at most 16 bytes apart, each component on a word boundary: every word from the first vertex's X
+    // to the last one's last component is tested, 16 bytes at a time. The words between vertices (padding, other
+    // attributes) are tested too: a NaN there sends the caller to the loop, which tests exactly what is read.
+    const uint64_t bytes = (last - first) * stride + sizeof(Word) * Components;
+    const bool wide = sizeof(Word) == 4;
+    const __m128i magnitude = wide ? _mm_set1_epi32(int32_t(kMagnitude)) : _mm_set1_epi16(int16_t(kMagnitude));
+    const __m128i infinity = wide ? _mm_set1_epi32(int32_t(kInfinity)) : _mm_set1_epi16(int16_t(kInfinity));
+    __m128i nan = _mm_setzero_si128();
+    uint64_t i = 0;
+    for (; i + 16 <= bytes; i += 16) {
+        const __m128i m = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(from + i)), magnitude);
+        nan = _mm_or_si128(nan, wide ? _mm_cmpgt_epi32(m, infinity) : _mm_cmpgt_epi16(m, infinity));
+    }
+    bool any = _mm_movemask_epi8(nan) != 0;
+    for (; i < bytes; i += sizeof(Word)) {
+        Word w;
+        std::memcpy(&w, from + i, sizeof(Word));
+        any |= Word(w & kMagnitude) > kInfinity;
+    }
+    return any;
+}
+
+bool EveryTriangleActive(const LoopInput& in, int indexBytes) {
+    const uint64_t n = in.count;
+    if (n == 0 || in.readableCount < n) return false;
+    uint64_t lo = 0, hi = 3 * n - 1;  // non-indexed: vertex j of the range for j < 3n
+    if (indexBytes == 1) IndexRange<uint8_t>(in.indices, 3 * n, &lo, &hi);
+    else if (indexBytes == 2) IndexRange<uint16_t>(in.indices, 3 * n, &lo, &hi);
+    else if (indexBytes == 4) IndexRange<uint32_t>(in.indices, 3 * n, &lo, &hi);
+    lo += in.firstVertex;  // indexed: firstVertex is added to each index (0 otherwise)
+    hi += in.firstVertex;
+    if (hi >= in.readableVertices) return false;  // some triangle is unreadable
+    const VertexFormatInfo& f = *in.info;
+    if (!f.hasNaN) return true;
+    if (hi - lo >= 3 * n) return false;
+    const bool z = f.componentCount >= 3;
+    const uint8_t* v = in.vertices;
+    if (f.kind == ComponentKind::Float32)
+        return z ? !AnyNaN<uint32_t, 3>(v, in.stride, lo, hi) : !AnyNaN<uint32_t, 2>(v, in.stride, lo, hi);
+    if (f.kind == ComponentKind::Float16)
+        return z ? !AnyNaN<uint16_t, 3>(v, in.stride, lo, hi) : !AnyNaN<uint16_t, 2>(v, in.stride, lo, hi);
+    return false;
+}
+
 }  // namespace
 
-ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states) {
+ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states,
+                                 ClassifyDetail detail) {
     const detail::FloatModeGuard mode;
     if (view.motionVertexData) return detail::ClassifyMotionTriangles(view, record, states);  // motion_triangles.cpp
     ClassifyResult r;
@@ -400,8 +533,18 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
     IndexHasher hasher{uint64_t(indexBytes)};
     const uint64_t hashBytes = hashing ? uint64_t(in.readableCount) * 3u * uint64_t(indexBytes) : 0;
     Counters c;
+    // Activity only, every triangle active and readable: the bits set at once, the indices hashed in one go.
+    const bool allActive = detail == ClassifyDetail::kActivity && !states && EveryTriangleActive(in, indexBytes);
+    if (allActive) {
+        c.active = n;
+        if (in.bits) {
+            std::fill(in.bits, in.bits + n / 64, ~uint64_t{0});
+            if (n % 64 != 0) in.bits[n / 64] = (uint64_t{1} << (n % 64)) - 1;
+        }
+        if (hashing) hasher.Blocks(in.indices, size_t(hashBytes & ~uint64_t(31)));
+    }
     const LoopFn loop = PickLoop(*info, indexBytes);
-    for (uint32_t begin = 0; begin < n; begin += kChunk) {
+    for (uint32_t begin = 0; begin < (allActive ? 0 : n); begin += kChunk) {
         in.begin = begin;
         in.end = n - begin > kChunk ? begin + kChunk : n;
         loop(in, c);

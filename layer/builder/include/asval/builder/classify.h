@@ -61,7 +61,14 @@ struct ClassifyResult {
 // Each function fills `record` (activity bits, counts, and for indexed triangles the index hash) and,
 // when `states` is not null, one PrimitiveState byte per primitive. `record` may be null to get counts only.
 // The record's storage is reused across calls when large enough.
-ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states);
+//
+// What ClassifyTriangles counts. kActivity: what an update's rules compare, exactly: the record, active,
+// inactive, undefinedNaN, unreadable, their first primitives and the transform and index-hash fields; degenerate,
+// sameIndex and overMaxVertex stay 0. It lets the common case (every triangle readable, no NaN in any vertex the
+// triangles can read) skip the per-triangle loop: one pass over the indices and one over those vertices.
+enum class ClassifyDetail : uint8_t { kFull, kActivity };
+ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecord* record, uint8_t* states,
+                                 ClassifyDetail detail = ClassifyDetail::kFull);
 ClassifyResult ClassifyAabbs(const AabbGeometryView& view, ActivityRecord* record, uint8_t* states);
 // Instances: active iff accelerationStructureReference != 0. Mask 0 is active. Degenerate instances (BLAS
 // without active primitives) need the BLAS records: see build_input.h.
