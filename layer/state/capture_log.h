@@ -288,6 +288,18 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
     return !overlapped_ && blob < blobs.size() && blobs[blob].present ? &blobs[blob] : nullptr;
   }
 
+  // How many infos and geometries the log holds: a command buffer recorded again (every frame, typically)
+  // reserves what its last recording used, so that its build commands do not grow the vectors step by step.
+  struct Size {
+    std::size_t infos = 0;
+    std::size_t geometries = 0;
+  };
+  Size RecordCounts() const { return {infos.size(), geometries.size()}; }
+  void ReserveRecords(const Size& size) {
+    infos.reserve(size.infos);
+    geometries.reserve(size.geometries);
+  }
+
   std::vector<CaptureSlab> slabs;
   VkDeviceSize bytes_captured = 0;
   std::vector<CapturedInfo> infos;

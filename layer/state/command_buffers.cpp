@@ -26,6 +26,7 @@ void CommandBufferState::Reset() {
   recording.Clear();
   recording_lost = false;
   secondaries.clear();
+  if (capture_log) last_capture_log_size_ = capture_log->RecordCounts();
   capture_log.reset();  // a submission still reading it keeps it
   capture_run.Close();  // its reservations were in that log
   executed_capture_logs.clear();

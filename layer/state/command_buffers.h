@@ -66,7 +66,10 @@ class CommandBufferState {
   VkPipeline compute_pipeline = VK_NULL_HANDLE;
   // The recording's capture log, made on its first capture with slabs from `owner`.
   CaptureLog& CaptureLogFor(const std::shared_ptr<CaptureSlabOwner>& owner) {
-    if (!capture_log) capture_log = std::make_shared<CaptureLog>(owner);
+    if (!capture_log) {
+      capture_log = std::make_shared<CaptureLog>(owner);
+      capture_log->ReserveRecords(last_capture_log_size_);
+    }
     return *capture_log;
   }
   // 1-based ordinal of the next call of `command`, for messages ("the 3rd vkCmd...").
@@ -96,6 +99,7 @@ class CommandBufferState {
 
  private:
   std::array<uint32_t, kOpCommandCount> calls_{};
+  CaptureLog::Size last_capture_log_size_;  // the last recording's log (CaptureLogFor reserves as much)
   mutable std::mutex published_mutex_;
   std::shared_ptr<const RecordedOps> published_;
   std::shared_ptr<const WithheldCommand> published_withheld_;
