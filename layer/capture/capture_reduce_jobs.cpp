@@ -136,8 +136,7 @@ ReducedSources SourcesOf(const CapturedGeometry& g, const CaptureSource* first, 
 }
 
 VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& sources) {
-  return ReducedBytes(g.type, g.range.primitiveCount, sources.indices ? sources.indices->size : 0,
-                      sources.transform != nullptr) +
+  return ReducedBytes(g.type, g.range.primitiveCount, sources.indices != nullptr, sources.transform != nullptr) +
          sizeof(ReduceJob);
 }
 
@@ -156,19 +155,18 @@ bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry&
     *why = CaptureSkip::kCaptureMemoryFailed;
     return false;
   }
-  const VkDeviceSize index_bytes = indices ? indices->size : 0;
+  const uint32_t n = g.range.primitiveCount;
   CapturedBytes out;
-  if (!log.Reserve(ReducedBytes(g.type, g.range.primitiveCount, index_bytes, transform != nullptr), &out)) {
+  if (!log.Reserve(ReducedBytes(g.type, n, indices != nullptr, transform != nullptr), &out)) {
     state.capture_counters.failures.capture_memory_failures.fetch_add(1, std::memory_order_relaxed);  // no slab
     *why = CaptureSkip::kCaptureMemoryFailed;
     return false;
   }
   g.data = out;
-  const VkDeviceSize bits = ReducedBitBytes(g.type, g.range.primitiveCount);
-  if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, index_bytes, true};
-  if (transform) {
-    g.transform = CapturedBytes{out.slab, out.offset + bits + (index_bytes + 3) / 4 * 4, transform->size, true};
-  }
+  const VkDeviceSize bits = ReducedBitBytes(g.type, n);
+  const VkDeviceSize hashes = indices ? ReducedHashBytes(n) : 0;  // the index hash's, per 64 triangles
+  if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, hashes, true};
+  if (transform) g.transform = CapturedBytes{out.slab, out.offset + bits + hashes, transform->size, true};
   g.reduced = true;
   AddJob(block, MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
                           transform ? transform->address : 0, log.AddressOf(out)));

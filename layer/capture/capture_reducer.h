@@ -37,7 +37,7 @@ struct ReduceJob {
   uint64_t data = 0;          // vertices (not indexed: the first one read), AABBs or instance records
   uint64_t indices = 0;       // indexed triangles: the first index read
   uint64_t out = 0;           // where the results go (ReducedGeometry, capture_log.h)
-  uint64_t transform = 0;     // triangles: the transform, copied after the indices (0: none, or not captured)
+  uint64_t transform = 0;     // triangles: the transform, copied after the index hash (0: none, or not captured)
 };
 static_assert(sizeof(ReduceJob) == 64, "ReduceJob must match reduce_inputs.comp's Job");
 

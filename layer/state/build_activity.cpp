@@ -46,8 +46,9 @@ builder::AabbGeometryView AabbView(const CaptureLog& log, const CapturedGeometry
 }
 
 // The record of a geometry the layer's dispatch classified on the device (CapturedGeometry::reduced): its bits as
-// the builder would have set them, and the index hash from the copied indices, as the builder computes it. False
-// when a primitive could not be read (an index above maxVertex), as for the builder's unreadable primitives.
+// the builder would have set them, and the index hash combined from the dispatch's block hashes, as the builder
+// computes it. False when a primitive could not be read (an index above maxVertex), as for the builder's unreadable
+// primitives.
 bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::ActivityRecord* record,
                    builder::ClassifyResult* out) {
   const ReducedGeometry reduced = log.Reduced(g);
@@ -73,9 +74,19 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
   }
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g.index_type != VK_INDEX_TYPE_NONE_KHR) {
     if (!g.indices.present) return false;
+    // The dispatch hashed each 64 triangles' indices where the build read them: the host combines one hash per
+    // block, whatever the triangle count.
+    const auto index_bytes = static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type));
+    builder::IndexHashCombiner combiner(index_bytes);
+    const uint8_t* hashes = log.Bytes(g.indices);
+    for (VkDeviceSize at = 0; at < g.indices.size; at += kReducedHashBytes) {
+      builder::Hash128 block;
+      std::memcpy(&block.lo, hashes + at, sizeof(block.lo));
+      std::memcpy(&block.hi, hashes + at + 8, sizeof(block.hi));
+      combiner.Add(block);
+    }
     record->hasIndexHash = true;
-    record->indexHash = builder::HashIndexBytes(log.Bytes(g.indices), static_cast<std::size_t>(g.indices.size),
-                                                static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type)));
+    record->indexHash = combiner.Finish(3 * uint64_t{n} * index_bytes);
   }
   record->activeCount = active;
   result.active = active;

@@ -129,9 +129,10 @@ struct CapturedGeometry {
 // instances, per word the first non-finite transform's (lane << 4) | element. Instances then have, per 64 records,
 // a summary of kReducedSummaryBytes: how many distinct references other than 0 they hold (a word, padded to 16
 // bytes), then each of those once (16 bytes: the reference, the first of the 64 records holding it, padding), in no
-// particular order. Indexed triangles then have their
-// index bytes (CapturedGeometry::indices points there), rounded up to whole words, and triangles with a captured
-// transform its 48 bytes (CapturedGeometry::transform).
+// particular order. Indexed triangles then have, per 64 triangles, the hash of their index bytes
+// (builder::HashIndexBlock: 16 bytes, lo then hi; CapturedGeometry::indices points there, kReducedHashBytes per
+// block), which the host combines into the geometry's index hash, and triangles with a captured transform its 48
+// bytes (CapturedGeometry::transform).
 inline uint32_t ReducedWords(uint32_t count) { return (count + 31) / 32; }
 inline constexpr VkDeviceSize kReducedSummaryBytes = 16 + 64 * 16;
 inline VkDeviceSize ReducedBitBytes(VkGeometryTypeKHR type, uint32_t count) {
@@ -139,8 +140,10 @@ inline VkDeviceSize ReducedBitBytes(VkGeometryTypeKHR type, uint32_t count) {
   if (type != VK_GEOMETRY_TYPE_INSTANCES_KHR) return arrays;
   return 8 * VkDeviceSize{count} + arrays + (VkDeviceSize{count} + 63) / 64 * kReducedSummaryBytes;
 }
-inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count, VkDeviceSize index_bytes, bool transform) {
-  return ReducedBitBytes(type, count) + (index_bytes + 3) / 4 * 4 + (transform ? 48 : 0);
+inline constexpr VkDeviceSize kReducedHashBytes = 16;
+inline VkDeviceSize ReducedHashBytes(uint32_t count) { return (VkDeviceSize{count} + 63) / 64 * kReducedHashBytes; }
+inline VkDeviceSize ReducedBytes(VkGeometryTypeKHR type, uint32_t count, bool indexed, bool transform) {
+  return ReducedBitBytes(type, count) + (indexed ? ReducedHashBytes(count) : 0) + (transform ? 48 : 0);
 }
 struct ReducedGeometry {
   enum Array : uint32_t { kActive = 0, kUndefined = 1, kNonFinite = 1, kUnreadable = 2, kFirstNonFinite = 2 };

@@ -346,8 +346,8 @@ void CheckFormats(VkIndexType type) {
         CHECK(s.infos == infos);
         if (!CaptureReducedRun()) {
           CHECK(s.bytes == infos * 6 * (e->bytes() + IndexBytes(type)));
-        } else {  // per info: its 64-byte job, three one-word bit arrays, and the six indices in whole words
-          CHECK(s.bytes == infos * (64 + 3 * 4 + (6 * IndexBytes(type) + 3) / 4 * 4));
+        } else {  // per info: its 64-byte job, three one-word bit arrays, and indexed one 16-byte index hash block
+          CHECK(s.bytes == infos * (64 + 3 * 4 + (IndexBytes(type) != 0 ? 16 : 0)));
         }
         CHECK(s.updates_judged == updates);
         CHECK(s.not_captured == 0);

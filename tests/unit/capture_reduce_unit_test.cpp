@@ -54,10 +54,14 @@ TEST_CASE("capture reduce unit: which instance pointers the layer follows, and t
 }
 
 TEST_CASE("capture reduce unit: a reduced geometry's bytes, and its bit arrays as the host reads them") {
-  // 40 triangles: two words per array, three arrays; 120 32-bit indices; a transform.
+  // 40 triangles: two words per array, three arrays; indexed: one block of the index hash (16 bytes per 64
+  // triangles, whatever the index type); a transform.
   CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40) == 3 * 2 * 4);
-  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40, 480, true) == 24 + 480 + 48);
-  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 1, 6, false) == 12 + 8);  // 16-bit indices: whole words
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40, true, true) == 24 + 16 + 48);
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 1, true, false) == 12 + 16);
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 65, true, false) == 3 * 3 * 4 + 2 * 16);  // two blocks
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 4096, true, false) == 3 * 128 * 4 + 64 * 16);
+  CHECK(ReducedBytes(VK_GEOMETRY_TYPE_TRIANGLES_KHR, 40, false, false) == 24);  // not indexed: no hash
   // 33 instances: 8 bytes of reference each, three arrays of two words, and one summary of 64 records (a 16-byte
   // header and 64 entries of 16 bytes).
   CHECK(ReducedBitBytes(VK_GEOMETRY_TYPE_INSTANCES_KHR, 33) == 33 * 8 + 3 * 2 * 4 + 16 + 64 * 16);

@@ -526,11 +526,12 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
     }
     if (!in.vertices) in.readableVertices = 0;
 
-    // Chunks of 4096 triangles (a multiple of 64 bits and of the hash's 32-byte blocks for every index
-    // size): each chunk's indices are hashed right after they were classified, while still in cache.
+    // Chunks of 4096 triangles (a multiple of 64 bits and of the hash's 64-triangle blocks): each chunk's indices
+    // are hashed right after they were classified, while still in cache.
     constexpr uint32_t kChunk = 4096;
+    static_assert(kChunk % kIndexHashBlockTriangles == 0, "a chunk holds whole blocks of the index hash");
     const bool hashing = record && indexBytes != 0;
-    IndexHasher hasher{uint64_t(indexBytes)};
+    IndexHashCombiner hasher{uint64_t(indexBytes)};
     const uint64_t hashBytes = hashing ? uint64_t(in.readableCount) * 3u * uint64_t(indexBytes) : 0;
     Counters c;
     // Activity only, every triangle active and readable: the bits set at once, the indices hashed in one go.
@@ -541,7 +542,7 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
             std::fill(in.bits, in.bits + n / 64, ~uint64_t{0});
             if (n % 64 != 0) in.bits[n / 64] = (uint64_t{1} << (n % 64)) - 1;
         }
-        if (hashing) hasher.Blocks(in.indices, size_t(hashBytes & ~uint64_t(31)));
+        if (hashing) hasher.AddBlocks(in.indices, size_t(hashBytes));
     }
     const LoopFn loop = PickLoop(*info, indexBytes);
     for (uint32_t begin = 0; begin < (allActive ? 0 : n); begin += kChunk) {
@@ -551,13 +552,12 @@ ClassifyResult ClassifyTriangles(const TriangleGeometryView& view, ActivityRecor
         if (hashing) {
             const uint64_t from = uint64_t(begin) * 3u * uint64_t(indexBytes);
             const uint64_t to = std::min<uint64_t>(uint64_t(in.end) * 3u * uint64_t(indexBytes), hashBytes);
-            if (to > from) hasher.Blocks(in.indices + from, size_t((to - from) & ~uint64_t(31)));
+            if (to > from) hasher.AddBlocks(in.indices + from, size_t(to - from));
         }
     }
     if (hashing) {
-        const uint64_t whole = hashBytes & ~uint64_t(31);
         record->hasIndexHash = true;
-        record->indexHash = hasher.Finish(in.indices + whole, size_t(hashBytes - whole), hashBytes);
+        record->indexHash = hasher.Finish(hashBytes);
     }
 
     r.active = c.active;

@@ -56,11 +56,45 @@ Hash128 IndexHasher::Finish(const void* tail, size_t tailBytes, uint64_t totalBy
     return {Fmix(a + b), Fmix(b ^ Rotl(a, 32))};
 }
 
-Hash128 HashIndexBytes(const void* data, size_t bytes, uint64_t seed) {
-    IndexHasher h(seed);
+Hash128 HashIndexBlock(const void* data, size_t bytes, uint64_t indexBytes) {
+    IndexHasher h(indexBytes);
     const size_t whole = bytes & ~size_t(31);
     h.Blocks(data, whole);
     return h.Finish(static_cast<const uint8_t*>(data) + whole, bytes - whole, bytes);
+}
+
+// The outer hash's seed: apart from every block's (an element size of 1, 2 or 4).
+IndexHashCombiner::IndexHashCombiner(uint64_t indexBytes)
+    : outer_(indexBytes ^ 0x6B6C6F6362000000ull), indexBytes_(indexBytes) {}
+
+void IndexHashCombiner::Add(const Hash128& block) {
+    if (!hasPending_) {
+        pending_[0] = block.lo;
+        pending_[1] = block.hi;
+        hasPending_ = true;
+        return;
+    }
+    const uint64_t step[4] = {pending_[0], pending_[1], block.lo, block.hi};
+    outer_.Blocks(step, sizeof(step));
+    hasPending_ = false;
+}
+
+void IndexHashCombiner::AddBlocks(const void* data, size_t bytes) {
+    const auto* p = static_cast<const uint8_t*>(data);
+    const size_t block = IndexHashBlockBytes(indexBytes_);
+    for (size_t at = 0; at < bytes; at += block) {
+        Add(HashIndexBlock(p + at, bytes - at < block ? bytes - at : block, indexBytes_));
+    }
+}
+
+Hash128 IndexHashCombiner::Finish(uint64_t totalBytes) {
+    return outer_.Finish(pending_, hasPending_ ? sizeof(pending_) : 0, totalBytes);
+}
+
+Hash128 HashIndexBytes(const void* data, size_t bytes, uint64_t indexBytes) {
+    IndexHashCombiner combiner(indexBytes);
+    combiner.AddBlocks(data, bytes);
+    return combiner.Finish(bytes);
 }
 
 }  // namespace asval::builder

@@ -3,8 +3,9 @@
 // vertices, AABBs or instance records to the host, the layer's dispatch reads them where the build reads them
 // and writes only what the rules need, as the reference builder defines it (layer/builder, classify.h):
 //   triangles  per primitive: active (no vertex's X is NaN), undefined input (a NaN Y or Z with X not NaN, active
-//              primitives only), unreadable (an index that names a vertex above maxVertex: never read); and the
-//              index bytes and the transform as they are (the host hashes the indices);
+//              primitives only), unreadable (an index that names a vertex above maxVertex: never read); per 64
+//              triangles the hash of their index bytes (builder::HashIndexBlock, layer/builder's index_hash.h, bit
+//              for bit: the host combines one hash per block); and the transform as it is;
 //   AABBs      per primitive: active (minX not NaN), undefined input (another NaN with minX not NaN);
 //   instances  per record: its accelerationStructureReference, active (a reference other than 0), and whether
 //              its transform has a NaN or infinite element (per 32 records, the first such one's element too);
@@ -71,6 +72,52 @@ uint LoadBytes(uvec2 address, uint bytes) {
   return bytes == 4u ? value : value & ((1u << (8u * bytes)) - 1u);
 }
 
+// 64-bit words as uvec2(low, high): what the index hash (index_hash.cpp) computes, without shaderInt64.
+uvec2 Mul64(uvec2 a, uvec2 b) {
+  uint hi, lo;
+  umulExtended(a.x, b.x, hi, lo);
+  return uvec2(lo, hi + a.x * b.y + a.y * b.x);
+}
+uvec2 Rotl64(uvec2 x, uint r) {  // 0 < r < 64
+  if (r >= 32u) { x = x.yx; r -= 32u; }
+  return r == 0u ? x : uvec2((x.x << r) | (x.y >> (32u - r)), (x.y << r) | (x.x >> (32u - r)));
+}
+uvec2 Fmix64(uvec2 k) {  // murmur3's finaliser: k ^= k >> 33 is k.x ^= k.y >> 1
+  k.x ^= k.y >> 1u;
+  k = Mul64(k, uvec2(0xED558CCDu, 0xFF51AFD7u));
+  k.x ^= k.y >> 1u;
+  k = Mul64(k, uvec2(0x1A85EC53u, 0xC4CEB9FEu));
+  k.x ^= k.y >> 1u;
+  return k;
+}
+const uvec2 kPrime[4] = uvec2[4](uvec2(0x85EBCA87u, 0x9E3779B1u), uvec2(0x27D4EB4Fu, 0xC2B2AE3Du),
+                                 uvec2(0x9E3779F9u, 0x165667B1u), uvec2(0x6659FD93u, 0xD6E8FEB8u));
+// Lane `lane` of the hash of `bytes` index bytes at `at` seeded with the element size: its word of each whole
+// 32-byte step, then its word of the tail (zero-padded), if the tail reaches it.
+uvec2 IndexHashLane(uvec2 at, uint bytes, uint seed, uint lane) {
+  const uvec2 s = uvec2(seed, 0u);
+  uvec2 h;
+  if (lane == 0u) h = s ^ kPrime[0];
+  else if (lane == 1u) h = Add64(s, kPrime[1].x, kPrime[1].y);
+  else if (lane == 2u) h = Rotl64(s, 17u) ^ kPrime[2];
+  else h = ~s ^ kPrime[3];
+  const uint whole = bytes & ~31u;
+  for (uint step = 0u; step < whole; step += 32u) {
+    const uvec2 word = Add64(at, step + 8u * lane, 0u);
+    const uvec2 w = uvec2(LoadBytes(word, 4u), LoadBytes(Add64(word, 4u, 0u), 4u));
+    h = Mul64(Rotl64(h ^ w, 29u), kPrime[lane]);
+  }
+  const uint tail = bytes - whole;
+  if (8u * lane < tail) {
+    const uint left = tail - 8u * lane;
+    const uvec2 word = Add64(at, whole + 8u * lane, 0u);
+    const uint high = left > 4u ? LoadBytes(Add64(word, 4u, 0u), min(4u, left - 4u)) : 0u;
+    const uvec2 w = uvec2(LoadBytes(word, min(4u, left)), high);
+    h = Mul64(Rotl64(h ^ w, 29u), kPrime[lane]);
+  }
+  return h;
+}
+
 bool NaN32(uint bits) { return (bits & 0x7fffffffu) > 0x7f800000u; }
 bool NaN16(uint bits) { return (bits & 0x7fffu) > 0x7c00u; }
 bool NonFinite32(uint bits) { return (bits & 0x7f800000u) == 0x7f800000u; }
@@ -81,6 +128,8 @@ shared uint s_bits[3][2];
 // Instances: this group's references (0: none, or inactive), and how many distinct ones it found.
 shared uvec2 s_refs[64];
 shared uint s_distinct;
+// Indexed triangles: the four lanes of the index hash of this group's 64 triangles.
+shared uvec2 s_lanes[4];
 
 void main() {
   const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
@@ -89,18 +138,14 @@ void main() {
   const uint words = (job.count + 31u) / 32u;
   const uint local = gl_LocalInvocationID.x;
   const uint stride_x = gl_NumWorkGroups.x * 64u;
-  // Triangles: the index bytes (rounded up to words) and the transform, copied after the bit arrays.
-  if (job.kind == 0u) {
-    const uvec2 out_indices = AddProduct(job.out_addr, 3u * words, 4u);
-    const uint index_total = 3u * job.count * job.index_bytes;
-    for (uint w = gl_WorkGroupID.x * 64u + local; 4u * w < index_total; w += stride_x) {
-      OutWords(AddProduct(out_indices, w, 4u)).w[0] =
-          LoadBytes(AddProduct(job.indices, w, 4u), min(4u, index_total - 4u * w));
-    }
-    if (gl_WorkGroupID.x == 0u && local < 12u && job.transform != uvec2(0u)) {
-      const uvec2 out_transform = AddProduct(out_indices, (index_total + 3u) / 4u, 4u);
-      OutWords(AddProduct(out_transform, local, 4u)).w[0] = LoadBytes(AddProduct(job.transform, local, 4u), 4u);
-    }
+  // Triangles: after the bit arrays, indexed ones the index hash's blocks (16 bytes per 64 triangles, written in
+  // the loop below), then the transform, copied.
+  const uint index_total = 3u * job.count * job.index_bytes;
+  const uint hash_blocks = job.index_bytes != 0u ? (job.count + 63u) / 64u : 0u;
+  const uvec2 out_hashes = AddProduct(job.out_addr, 3u * words, 4u);
+  if (job.kind == 0u && gl_WorkGroupID.x == 0u && local < 12u && job.transform != uvec2(0u)) {
+    const uvec2 out_transform = AddProduct(out_hashes, hash_blocks, 16u);
+    OutWords(AddProduct(out_transform, local, 4u)).w[0] = LoadBytes(AddProduct(job.transform, local, 4u), 4u);
   }
   // Arrays of instance pointers: gathered, no bits (the host classifies the records as it does copied ones). The
   // job is the group's, so the whole group returns here, before any barrier.
@@ -189,7 +234,25 @@ void main() {
       if (undefined_input) atomicOr(s_bits[1][local / 32u], bit);
       if (unreadable) atomicOr(s_bits[2][local / 32u], bit);
     }
+    // Indexed triangles: these 64 triangles' indices hashed, one lane per invocation (each lane is a chain).
+    const uint block_first = 3u * group_first * job.index_bytes;
+    const uint block_bytes = min(192u * job.index_bytes, index_total - min(block_first, index_total));
+    if (job.kind == 0u && job.index_bytes != 0u && local < 4u) {
+      s_lanes[local] = IndexHashLane(Add64(job.indices, block_first, 0u), block_bytes, job.index_bytes, local);
+    }
     barrier();
+    if (job.kind == 0u && job.index_bytes != 0u && local == 0u) {  // IndexHasher::Finish
+      const uvec2 total = uvec2(block_bytes, 0u);
+      const uvec2 a = Fmix64(s_lanes[0] ^ Rotl64(s_lanes[2], 23u) ^ total);
+      const uvec2 b = Fmix64(s_lanes[1] ^ Rotl64(s_lanes[3], 41u) ^ Mul64(total, kPrime[0]));
+      const uvec2 lo = Fmix64(Add64(a, b.x, b.y));
+      const uvec2 hi = Fmix64(b ^ Rotl64(a, 32u));
+      OutWords hash_out = OutWords(AddProduct(out_hashes, group_first / 64u, 16u));
+      hash_out.w[0] = lo.x;
+      hash_out.w[1] = lo.y;
+      hash_out.w[2] = hi.x;
+      hash_out.w[3] = hi.y;
+    }
     // Instances: each distinct reference of these 64 records once, with the first record holding it, so that the
     // host looks up a few references per 64 records (the records' own, all of them, stay above for messages).
     const uvec2 summary =
