@@ -45,6 +45,33 @@ builder::AabbGeometryView AabbView(const CaptureLog& log, const CapturedGeometry
   return view;
 }
 
+// Set bits of a word, and its lowest set bit's index (bits != 0), without a library call (the build does not
+// assume the popcnt instruction).
+uint32_t PopCount64(uint64_t x) {
+  x -= (x >> 1) & 0x5555555555555555ull;
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<uint32_t>((x * 0x0101010101010101ull) >> 56);
+}
+uint32_t CountTrailingZeros(uint64_t bits) { return static_cast<uint32_t>(__builtin_ctzll(bits)); }
+
+// Whether any of `words` 32-bit words at `bytes` is not 0.
+bool AnyBitSet(const uint8_t* bytes, std::size_t words) {
+  uint64_t any = 0;
+  std::size_t w = 0;
+  for (; w + 2 <= words; w += 2) {
+    uint64_t pair;
+    std::memcpy(&pair, bytes + 4 * w, sizeof(pair));
+    any |= pair;
+  }
+  if (w < words) {
+    uint32_t last;
+    std::memcpy(&last, bytes + 4 * w, sizeof(last));
+    any |= last;
+  }
+  return any != 0;
+}
+
 // The record of a geometry the layer's dispatch classified on the device (CapturedGeometry::reduced): its bits as
 // the builder would have set them, and the index hash combined from the dispatch's block hashes, as the builder
 // computes it. False when a primitive could not be read (an index above maxVertex), as for the builder's unreadable
@@ -59,17 +86,24 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
   record->indexHash = {};
   builder::ClassifyResult result;
   result.primitiveCount = n;
-  uint32_t active = 0;
   const bool instances = g.type == VK_GEOMETRY_TYPE_INSTANCES_KHR;
-  for (uint32_t w = 0; w < ReducedWords(n); ++w) {
-    if (!instances && reduced.Word(ReducedGeometry::kUnreadable, w) != 0) return false;
-    const uint32_t bits = reduced.Word(ReducedGeometry::kActive, w);
-    record->activeBits[w / 2] |= uint64_t{bits} << (32 * (w % 2));
-    active += static_cast<uint32_t>(__builtin_popcount(bits));
-    if (instances) continue;  // their second array is the transforms' (the warning reads it)
-    if (const uint32_t undefined = reduced.Word(ReducedGeometry::kUndefined, w)) {
-      if (result.undefinedNaN == 0) result.firstUndefined = 32 * w + static_cast<uint32_t>(__builtin_ctz(undefined));
-      result.undefinedNaN += static_cast<uint32_t>(__builtin_popcount(undefined));
+  // 64 bits at a time, whatever the primitive count asks of the host: two of the device's little-endian words are
+  // one word of the record, and a word with no bit set (the common case) costs a test.
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the device's bit arrays are the record's bytes");
+  const std::size_t words = ReducedWords(n);
+  const std::size_t words64 = record->activeBits.size();
+  if (!instances && AnyBitSet(reduced.ArrayBytes(ReducedGeometry::kUnreadable), words)) return false;
+  if (words != 0) std::memcpy(record->activeBits.data(), reduced.ArrayBytes(ReducedGeometry::kActive), 4 * words);
+  uint32_t active = 0;
+  for (std::size_t w = 0; w < words64; ++w) active += PopCount64(record->activeBits[w]);
+  if (!instances) {  // their second array is the transforms' (the warning reads it)
+    const uint8_t* undefined = reduced.ArrayBytes(ReducedGeometry::kUndefined);
+    for (std::size_t w = 0; w < words64; ++w) {
+      uint64_t bits = 0;
+      std::memcpy(&bits, undefined + 8 * w, 2 * w + 1 < words ? 8 : 4);
+      if (bits == 0) continue;
+      if (result.undefinedNaN == 0) result.firstUndefined = static_cast<uint32_t>(64 * w) + CountTrailingZeros(bits);
+      result.undefinedNaN += PopCount64(bits);
     }
   }
   if (g.type == VK_GEOMETRY_TYPE_TRIANGLES_KHR && g.index_type != VK_INDEX_TYPE_NONE_KHR) {
@@ -78,13 +112,7 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
     // block, whatever the triangle count.
     const auto index_bytes = static_cast<uint64_t>(builder::IndexTypeBytes(g.index_type));
     builder::IndexHashCombiner combiner(index_bytes);
-    const uint8_t* hashes = log.Bytes(g.indices);
-    for (VkDeviceSize at = 0; at < g.indices.size; at += kReducedHashBytes) {
-      builder::Hash128 block;
-      std::memcpy(&block.lo, hashes + at, sizeof(block.lo));
-      std::memcpy(&block.hi, hashes + at + 8, sizeof(block.hi));
-      combiner.Add(block);
-    }
+    combiner.AddHashes(log.Bytes(g.indices), static_cast<std::size_t>(g.indices.size / kReducedHashBytes));
     record->hasIndexHash = true;
     record->indexHash = combiner.Finish(3 * uint64_t{n} * index_bytes);
   }

@@ -153,9 +153,11 @@ struct ReducedGeometry {
   // Word w of bit array a.
   uint32_t Word(Array a, uint32_t w) const {
     uint32_t v;
-    std::memcpy(&v, Arrays() + 4 * (VkDeviceSize{a} * ReducedWords(count) + w), sizeof(v));
+    std::memcpy(&v, ArrayBytes(a) + 4 * VkDeviceSize{w}, sizeof(v));
     return v;
   }
+  // Bit array a: ReducedWords(count) little-endian words.
+  const uint8_t* ArrayBytes(Array a) const { return Arrays() + 4 * VkDeviceSize{a} * ReducedWords(count); }
   // Instances: the references.
   const uint8_t* references() const { return base; }
   // Instances: the summary of records 64 * group .. 64 * group + 63: how many distinct references, and each.

@@ -1,6 +1,7 @@
 // Activity records: bit layout, CompareActivity against a brute-force comparison, the index hash.
 #include <catch2/catch_test_macros.hpp>
 
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -100,6 +101,29 @@ TEST_CASE("index hash: any single changed index value changes the hash; equal in
             changed = idx;
             std::swap(changed[0], changed[n - 1]);
             CHECK(h != HashIndexBytes(changed.data(), n * 4, 4));
+        }
+    }
+}
+
+TEST_CASE("index hash: block hashes added as stored bytes combine as added one by one", "[record][hash]") {
+    // What the layer reads back from the device (16 bytes per block, lo then hi), in batches of every size after
+    // an even or an odd number of hashes added singly.
+    testsupport::Rng rng(27);
+    for (uint32_t before = 0; before < 3; ++before) {
+        for (uint32_t count = 0; count < 7; ++count) {
+            std::vector<Hash128> blocks(before + count);
+            for (Hash128& b : blocks) b = {rng.Next(), rng.Next()};
+            std::vector<uint8_t> stored(16 * size_t(count));
+            for (uint32_t k = 0; k < count; ++k) {
+                std::memcpy(stored.data() + 16 * k, &blocks[before + k].lo, 8);
+                std::memcpy(stored.data() + 16 * k + 8, &blocks[before + k].hi, 8);
+            }
+            IndexHashCombiner one_by_one(2), batched(2);
+            for (const Hash128& b : blocks) one_by_one.Add(b);
+            for (uint32_t k = 0; k < before; ++k) batched.Add(blocks[k]);
+            batched.AddHashes(stored.data(), count);
+            CAPTURE(before, count);
+            CHECK(batched.Finish(1000) == one_by_one.Finish(1000));
         }
     }
 }

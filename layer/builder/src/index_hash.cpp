@@ -79,6 +79,24 @@ void IndexHashCombiner::Add(const Hash128& block) {
     hasPending_ = false;
 }
 
+void IndexHashCombiner::AddHashes(const void* hashes, size_t count) {
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the stored hashes' bytes are the lanes' words");
+    const auto* p = static_cast<const uint8_t*>(hashes);
+    if (count != 0 && hasPending_) {
+        Hash128 first;
+        std::memcpy(&first.lo, p, 8);
+        std::memcpy(&first.hi, p + 8, 8);
+        Add(first);
+        p += 16;
+        --count;
+    }
+    outer_.Blocks(p, count / 2 * 32);
+    if (count % 2 != 0) {
+        std::memcpy(pending_, p + count / 2 * 32, 16);
+        hasPending_ = true;
+    }
+}
+
 void IndexHashCombiner::AddBlocks(const void* data, size_t bytes) {
     const auto* p = static_cast<const uint8_t*>(data);
     const size_t block = IndexHashBlockBytes(indexBytes_);

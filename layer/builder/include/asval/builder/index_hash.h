@@ -46,6 +46,9 @@ class IndexHashCombiner {
 public:
     explicit IndexHashCombiner(uint64_t indexBytes);
     void Add(const Hash128& block);
+    // `count` block hashes stored as a device writes them: 16 bytes each, lo then hi, little-endian. The same as
+    // Add() for each, in order, with no call per hash (two hashes are one step of the lanes).
+    void AddHashes(const void* hashes, size_t count);
     // Each block of `bytes` at `data` (its start a block's), added in order.
     void AddBlocks(const void* data, size_t bytes);
     Hash128 Finish(uint64_t totalBytes);
