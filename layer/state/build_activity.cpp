@@ -95,12 +95,17 @@ bool RecordReduced(const CaptureLog& log, const CapturedGeometry& g, builder::Ac
   if (!instances && AnyBitSet(reduced.ArrayBytes(ReducedGeometry::kUnreadable), words)) return false;
   if (words != 0) std::memcpy(record->activeBits.data(), reduced.ArrayBytes(ReducedGeometry::kActive), 4 * words);
   uint32_t active = 0;
-  for (std::size_t w = 0; w < words64; ++w) active += PopCount64(record->activeBits[w]);
-  if (!instances) {  // their second array is the transforms' (the warning reads it)
-    const uint8_t* undefined = reduced.ArrayBytes(ReducedGeometry::kUndefined);
+  for (const uint64_t bits : record->activeBits) active += bits == ~0ull ? 64 : PopCount64(bits);
+  const uint8_t* undefined = reduced.ArrayBytes(ReducedGeometry::kUndefined);
+  // Instances' second array is the transforms' (the warning reads it); a valid refit has no undefined vertex.
+  if (!instances && AnyBitSet(undefined, words)) {
     for (std::size_t w = 0; w < words64; ++w) {
       uint64_t bits = 0;
-      std::memcpy(&bits, undefined + 8 * w, 2 * w + 1 < words ? 8 : 4);
+      if (2 * w + 1 < words) {
+        std::memcpy(&bits, undefined + 8 * w, 8);
+      } else {
+        std::memcpy(&bits, undefined + 8 * w, 4);
+      }
       if (bits == 0) continue;
       if (result.undefinedNaN == 0) result.firstUndefined = static_cast<uint32_t>(64 * w) + CountTrailingZeros(bits);
       result.undefinedNaN += PopCount64(bits);
