@@ -56,6 +56,7 @@ struct DeviceOptions {
   void* features = nullptr;  // a chain of feature structures, chained after the Device's own
   bool timeline_semaphore = false;  // VkPhysicalDeviceVulkan12Features::timelineSemaphore
   uint32_t queue_count = 1;         // queues of the chosen family, at most what it offers (queue_count())
+  bool host_commands = false;  // VkPhysicalDeviceAccelerationStructureFeaturesKHR::accelerationStructureHostCommands
 };
 
 // Whether the physical device has a device extension.

@@ -1,0 +1,306 @@
+// The test driver's entry points: the loader's layer interface, instance and device creation (the features it
+// adds are reported to the layers above and taken out of what reaches the driver below), and the commands it
+// executes itself. Everything else goes down the chain unchanged.
+#include <cstring>
+#include <string>
+
+#include "deferred_operations.h"
+#include "device_executor.h"
+#include "driver_dispatch.h"
+#include "host_commands.h"
+
+#define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
+
+namespace asval_test_driver {
+namespace {
+
+// The features the test driver adds to the driver below: it executes these commands itself.
+void AddFeatures(void* chain) {
+  for (auto* s = static_cast<VkBaseOutStructure*>(chain); s != nullptr; s = s->pNext) {
+    if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR) {
+      reinterpret_cast<VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(s)->accelerationStructureHostCommands =
+          VK_TRUE;
+    }
+  }
+}
+
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
+  InstanceData* instance = InstanceOf(gpu);
+  instance->GetPhysicalDeviceFeatures2(gpu, features);
+  AddFeatures(features->pNext);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2KHR(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
+  InstanceData* instance = InstanceOf(gpu);
+  (instance->GetPhysicalDeviceFeatures2KHR ? instance->GetPhysicalDeviceFeatures2KHR
+                                           : instance->GetPhysicalDeviceFeatures2)(gpu, features);
+  AddFeatures(features->pNext);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL EnumeratePhysicalDevices(VkInstance handle, uint32_t* count, VkPhysicalDevice* gpus) {
+  InstanceData* instance = FindInstance(handle);
+  const VkResult result = instance->EnumeratePhysicalDevices(handle, count, gpus);
+  if (gpus != nullptr && (result == VK_SUCCESS || result == VK_INCOMPLETE)) {
+    for (uint32_t i = 0; i < *count; ++i) AddPhysicalDevice(gpus[i], instance);
+  }
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* info, const VkAllocationCallbacks* allocator,
+                                              VkInstance* out) {
+  auto* link = static_cast<VkLayerInstanceCreateInfo*>(const_cast<void*>(info->pNext));
+  while (link != nullptr &&
+         !(link->sType == VK_STRUCTURE_TYPE_LOADER_INSTANCE_CREATE_INFO && link->function == VK_LAYER_LINK_INFO)) {
+    link = static_cast<VkLayerInstanceCreateInfo*>(const_cast<void*>(link->pNext));
+  }
+  if (link == nullptr) return VK_ERROR_INITIALIZATION_FAILED;
+  const PFN_vkGetInstanceProcAddr next = link->u.pLayerInfo->pfnNextGetInstanceProcAddr;
+  link->u.pLayerInfo = link->u.pLayerInfo->pNext;
+  auto create = reinterpret_cast<PFN_vkCreateInstance>(next(VK_NULL_HANDLE, "vkCreateInstance"));
+  const VkResult result = create(info, allocator, out);
+  if (result != VK_SUCCESS) return result;
+  InstanceData* data = AddInstance(*out);
+  data->next_gipa = next;
+#define ASVAL_DRIVER_LOAD(name) data->name = reinterpret_cast<PFN_vk##name>(next(*out, "vk" #name))
+  ASVAL_DRIVER_LOAD(DestroyInstance);
+  ASVAL_DRIVER_LOAD(EnumeratePhysicalDevices);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceFeatures2);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceFeatures2KHR);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties);
+  ASVAL_DRIVER_LOAD(CreateDevice);
+#undef ASVAL_DRIVER_LOAD
+  return VK_SUCCESS;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyInstance(VkInstance handle, const VkAllocationCallbacks* allocator) {
+  InstanceData* instance = FindInstance(handle);
+  if (instance == nullptr) return;
+  const PFN_vkDestroyInstance destroy = instance->DestroyInstance;
+  RemoveInstance(handle);
+  destroy(handle, allocator);
+}
+
+// The features the test driver adds, switched off in the application's chain while the driver below creates the
+// device (it has not got them), then restored: the application's structures are its own.
+struct HiddenFeatures {
+  explicit HiddenFeatures(const void* chain) {
+    for (auto* s = static_cast<const VkBaseInStructure*>(chain); s != nullptr; s = s->pNext) {
+      if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR) {
+        as_ = reinterpret_cast<VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(const_cast<VkBaseInStructure*>(s));
+        host_commands_ = as_->accelerationStructureHostCommands;
+        as_->accelerationStructureHostCommands = VK_FALSE;
+      }
+    }
+  }
+  ~HiddenFeatures() {
+    if (as_ != nullptr) as_->accelerationStructureHostCommands = host_commands_;
+  }
+  HiddenFeatures(const HiddenFeatures&) = delete;
+  HiddenFeatures& operator=(const HiddenFeatures&) = delete;
+
+ private:
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR* as_ = nullptr;
+  VkBool32 host_commands_ = VK_FALSE;
+};
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDeviceCreateInfo* info,
+                                            const VkAllocationCallbacks* allocator, VkDevice* out) {
+  InstanceData* instance = InstanceOf(gpu);
+  auto* link = static_cast<VkLayerDeviceCreateInfo*>(const_cast<void*>(info->pNext));
+  while (link != nullptr &&
+         !(link->sType == VK_STRUCTURE_TYPE_LOADER_DEVICE_CREATE_INFO && link->function == VK_LAYER_LINK_INFO)) {
+    link = static_cast<VkLayerDeviceCreateInfo*>(const_cast<void*>(link->pNext));
+  }
+  if (instance == nullptr || link == nullptr) return VK_ERROR_INITIALIZATION_FAILED;
+  const PFN_vkGetInstanceProcAddr next_gipa = link->u.pLayerInfo->pfnNextGetInstanceProcAddr;
+  const PFN_vkGetDeviceProcAddr next_gdpa = link->u.pLayerInfo->pfnNextGetDeviceProcAddr;
+  link->u.pLayerInfo = link->u.pLayerInfo->pNext;
+  auto create = reinterpret_cast<PFN_vkCreateDevice>(next_gipa(instance->instance, "vkCreateDevice"));
+  VkResult result;
+  {
+    const HiddenFeatures hidden(info->pNext);
+    result = create(gpu, info, allocator, out);
+  }
+  if (result != VK_SUCCESS) return result;
+  DeviceData* device = AddDevice(*out);
+  device->next_gdpa = next_gdpa;
+#define ASVAL_DRIVER_LOAD(name) device->vk.name = reinterpret_cast<PFN_vk##name>(next_gdpa(*out, "vk" #name));
+  ASVAL_DRIVER_DEVICE_FUNCTIONS(ASVAL_DRIVER_LOAD)
+#undef ASVAL_DRIVER_LOAD
+  instance->GetPhysicalDeviceMemoryProperties(gpu, &device->memory);
+  device->queue_family = info->queueCreateInfoCount != 0 ? info->pQueueCreateInfos[0].queueFamilyIndex : 0;
+  device->executor = std::make_unique<DeviceExecutor>(*device);
+  device->deferred = std::make_unique<DeferredOperations>();
+  return VK_SUCCESS;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice handle, const VkAllocationCallbacks* allocator) {
+  DeviceData* device = FindDevice(handle);
+  if (device == nullptr) return;
+  device->executor.reset();  // its pool and fence belong to the device
+  const PFN_vkDestroyDevice destroy = device->vk.DestroyDevice;
+  RemoveDevice(handle);
+  destroy(handle, allocator);
+}
+
+// Queues are externally synchronized: the application's submissions and waits take the lock the test driver's
+// own submissions take.
+VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
+  DeviceData* device = FindDevice(queue);
+  std::lock_guard<std::mutex> lock(device->queue_lock);
+  return device->vk.QueueSubmit(queue, count, submits, fence);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t count, const VkSubmitInfo2* submits,
+                                            VkFence fence) {
+  DeviceData* device = FindDevice(queue);
+  std::lock_guard<std::mutex> lock(device->queue_lock);
+  return device->vk.QueueSubmit2(queue, count, submits, fence);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
+  DeviceData* device = FindDevice(queue);
+  std::lock_guard<std::mutex> lock(device->queue_lock);
+  return device->vk.QueueWaitIdle(queue);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetAccelerationStructureBuildSizesKHR(
+    VkDevice handle, VkAccelerationStructureBuildTypeKHR, const VkAccelerationStructureBuildGeometryInfoKHR* info,
+    const uint32_t* counts, VkAccelerationStructureBuildSizesInfoKHR* sizes) {
+  // Host builds run on the device: the device's sizes are theirs.
+  DeviceData* device = FindDevice(handle);
+  device->vk.GetAccelerationStructureBuildSizesKHR(handle, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, info,
+                                                   counts, sizes);
+}
+
+// A host command now, or when its deferred operation is joined. The parameters stay the application's until the
+// operation completes (VK_KHR_deferred_host_operations), so the work keeps pointers to them.
+VkResult RunOrDefer(DeviceData* device, VkDeferredOperationKHR operation, std::function<VkResult()> work) {
+  if (operation == VK_NULL_HANDLE) return work();
+  return device->deferred->Defer(operation, std::move(work));
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL
+BuildAccelerationStructuresKHR(VkDevice handle, VkDeferredOperationKHR operation, uint32_t count,
+                               const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                               const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
+  DeviceData* device = FindDevice(handle);
+  return RunOrDefer(device, operation, [=] { return BuildOnHost(*device, count, infos, ranges); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice handle, VkDeferredOperationKHR operation,
+                                                            const VkCopyAccelerationStructureInfoKHR* info) {
+  DeviceData* device = FindDevice(handle);
+  return RunOrDefer(device, operation, [=] { return CopyOnHost(*device, *info); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
+    VkDevice handle, VkDeferredOperationKHR operation, const VkCopyAccelerationStructureToMemoryInfoKHR* info) {
+  DeviceData* device = FindDevice(handle);
+  return RunOrDefer(device, operation, [=] { return CopyToMemoryOnHost(*device, *info); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CopyMemoryToAccelerationStructureKHR(
+    VkDevice handle, VkDeferredOperationKHR operation, const VkCopyMemoryToAccelerationStructureInfoKHR* info) {
+  DeviceData* device = FindDevice(handle);
+  return RunOrDefer(device, operation, [=] { return CopyFromMemoryOnHost(*device, *info); });
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(VkDevice handle, uint32_t count,
+                                                                        const VkAccelerationStructureKHR* structures,
+                                                                        VkQueryType type, size_t data_size, void* data,
+                                                                        size_t stride) {
+  DeviceData* device = FindDevice(handle);
+  return WritePropertiesOnHost(*device, count, structures, type, data_size, data, stride);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL DeferredOperationJoinKHR(VkDevice handle, VkDeferredOperationKHR operation) {
+  return FindDevice(handle)->deferred->Join(operation);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL GetDeferredOperationResultKHR(VkDevice handle, VkDeferredOperationKHR operation) {
+  return FindDevice(handle)->deferred->Result(operation);
+}
+
+VKAPI_ATTR uint32_t VKAPI_CALL GetDeferredOperationMaxConcurrencyKHR(VkDevice, VkDeferredOperationKHR) { return 1; }
+
+VKAPI_ATTR void VKAPI_CALL DestroyDeferredOperationKHR(VkDevice handle, VkDeferredOperationKHR operation,
+                                                       const VkAllocationCallbacks* allocator) {
+  DeviceData* device = FindDevice(handle);
+  device->deferred->Forget(operation);
+  device->vk.DestroyDeferredOperationKHR(handle, operation, allocator);
+}
+
+PFN_vkVoidFunction DeviceFunction(const char* name) {
+#define ASVAL_DRIVER_HOOK(fn) \
+  if (std::strcmp(name, "vk" #fn) == 0) return reinterpret_cast<PFN_vkVoidFunction>(&fn);
+  ASVAL_DRIVER_HOOK(DestroyDevice)
+  ASVAL_DRIVER_HOOK(QueueSubmit)
+  ASVAL_DRIVER_HOOK(QueueSubmit2)
+  ASVAL_DRIVER_HOOK(QueueWaitIdle)
+  ASVAL_DRIVER_HOOK(GetAccelerationStructureBuildSizesKHR)
+  ASVAL_DRIVER_HOOK(BuildAccelerationStructuresKHR)
+  ASVAL_DRIVER_HOOK(CopyAccelerationStructureKHR)
+  ASVAL_DRIVER_HOOK(CopyAccelerationStructureToMemoryKHR)
+  ASVAL_DRIVER_HOOK(CopyMemoryToAccelerationStructureKHR)
+  ASVAL_DRIVER_HOOK(WriteAccelerationStructuresPropertiesKHR)
+  ASVAL_DRIVER_HOOK(DeferredOperationJoinKHR)
+  ASVAL_DRIVER_HOOK(GetDeferredOperationResultKHR)
+  ASVAL_DRIVER_HOOK(GetDeferredOperationMaxConcurrencyKHR)
+  ASVAL_DRIVER_HOOK(DestroyDeferredOperationKHR)
+  if (std::strcmp(name, "vkQueueSubmit2KHR") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&QueueSubmit2);
+  return nullptr;
+}
+
+PFN_vkVoidFunction InstanceFunction(const char* name) {
+  ASVAL_DRIVER_HOOK(CreateInstance)
+  ASVAL_DRIVER_HOOK(DestroyInstance)
+  ASVAL_DRIVER_HOOK(EnumeratePhysicalDevices)
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceFeatures2)
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceFeatures2KHR)
+  ASVAL_DRIVER_HOOK(CreateDevice)
+#undef ASVAL_DRIVER_HOOK
+  return nullptr;
+}
+
+}  // namespace
+
+PFN_vkVoidFunction GetDeviceProcAddr(VkDevice handle, const char* name) {
+  if (std::strcmp(name, "vkGetDeviceProcAddr") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceProcAddr);
+  if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
+  DeviceData* device = handle != VK_NULL_HANDLE ? FindDevice(handle) : nullptr;
+  return device != nullptr ? device->next_gdpa(handle, name) : nullptr;
+}
+
+PFN_vkVoidFunction GetInstanceProcAddr(VkInstance handle, const char* name) {
+  if (std::strcmp(name, "vkGetInstanceProcAddr") == 0) {
+    return reinterpret_cast<PFN_vkVoidFunction>(&GetInstanceProcAddr);
+  }
+  if (std::strcmp(name, "vkGetDeviceProcAddr") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceProcAddr);
+  if (PFN_vkVoidFunction own = InstanceFunction(name)) return own;
+  if (handle == VK_NULL_HANDLE) return nullptr;
+  if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
+  InstanceData* instance = FindInstance(handle);
+  return instance != nullptr ? instance->next_gipa(handle, name) : nullptr;
+}
+
+}  // namespace asval_test_driver
+
+ASVAL_DRIVER_EXPORT VKAPI_ATTR VkResult VKAPI_CALL
+vkNegotiateLoaderLayerInterfaceVersion(VkNegotiateLayerInterface* version) {
+  if (version == nullptr || version->sType != LAYER_NEGOTIATE_INTERFACE_STRUCT) return VK_ERROR_INITIALIZATION_FAILED;
+  if (version->loaderLayerInterfaceVersion > 2) version->loaderLayerInterfaceVersion = 2;
+  version->pfnGetInstanceProcAddr = &asval_test_driver::GetInstanceProcAddr;
+  version->pfnGetDeviceProcAddr = &asval_test_driver::GetDeviceProcAddr;
+  version->pfnGetPhysicalDeviceProcAddr = nullptr;
+  return VK_SUCCESS;
+}
+
+ASVAL_DRIVER_EXPORT VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instance,
+                                                                                   const char* name) {
+  return asval_test_driver::GetInstanceProcAddr(instance, name);
+}
+
+ASVAL_DRIVER_EXPORT VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetDeviceProcAddr(VkDevice device, const char* name) {
+  return asval_test_driver::GetDeviceProcAddr(device, name);
+}

@@ -1,0 +1,226 @@
+// The test driver through the real loader, alone over lavapipe: what it reports, and that what it executes is what
+// the device executes for the same inputs (a host build and its device twin serialize to the same bytes).
+#include <catch2/catch_test_macros.hpp>
+#include <cstring>
+#include <vector>
+
+#include "vkkit.h"
+
+namespace {
+
+template <typename F>
+F Load(VkDevice device, const char* name) {
+  return reinterpret_cast<F>(vkGetDeviceProcAddr(device, name));
+}
+
+// An instance with the test driver alone, a device with host commands, and the host commands.
+struct DriverDevice {
+  vkkit::Instance instance{vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false}};
+  VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  vkkit::Device device{instance, gpu, Options()};
+  VkDevice vk = device.handle();
+  PFN_vkBuildAccelerationStructuresKHR Build =
+      Load<PFN_vkBuildAccelerationStructuresKHR>(vk, "vkBuildAccelerationStructuresKHR");
+  PFN_vkCopyAccelerationStructureToMemoryKHR ToMemory =
+      Load<PFN_vkCopyAccelerationStructureToMemoryKHR>(vk, "vkCopyAccelerationStructureToMemoryKHR");
+  PFN_vkCopyMemoryToAccelerationStructureKHR FromMemory =
+      Load<PFN_vkCopyMemoryToAccelerationStructureKHR>(vk, "vkCopyMemoryToAccelerationStructureKHR");
+  PFN_vkCopyAccelerationStructureKHR Copy =
+      Load<PFN_vkCopyAccelerationStructureKHR>(vk, "vkCopyAccelerationStructureKHR");
+  PFN_vkWriteAccelerationStructuresPropertiesKHR Properties =
+      Load<PFN_vkWriteAccelerationStructuresPropertiesKHR>(vk, "vkWriteAccelerationStructuresPropertiesKHR");
+
+  static vkkit::DeviceOptions Options() {
+    vkkit::DeviceOptions options;
+    options.host_commands = true;
+    return options;
+  }
+
+  uint64_t Property(VkAccelerationStructureKHR as, VkQueryType type) {
+    uint64_t value = 0;
+    vkkit::Check(Properties(vk, 1, &as, type, sizeof(value), &value, sizeof(value)), "properties");
+    return value;
+  }
+
+  std::vector<unsigned char> Serialize(VkAccelerationStructureKHR as) {
+    std::vector<unsigned char> bytes(Property(as, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR));
+    VkCopyAccelerationStructureToMemoryInfoKHR info{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+    info.src = as;
+    info.dst.hostAddress = bytes.data();
+    info.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+    vkkit::Check(ToMemory(vk, VK_NULL_HANDLE, &info), "serialize");
+    return bytes;
+  }
+
+  VkAccelerationStructureBuildSizesInfoKHR Sizes(const VkAccelerationStructureBuildGeometryInfoKHR& info,
+                                                 uint32_t count) {
+    VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+    device.GetAccelerationStructureBuildSizesKHR(vk, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_HOST_KHR, &info, &count,
+                                                 &sizes);
+    return sizes;
+  }
+};
+
+// Two triangles, uint16 indices at primitiveOffset 4, firstVertex 2: the vertices before firstVertex and the
+// bytes before the indices are garbage a correct build never reads.
+struct Mesh {
+  float vertices[7 * 4] = {9e9f, 9e9f, 9e9f, 0, 9e9f, 9e9f, 9e9f, 0,  // skipped by firstVertex
+                           0,    0,    0,    0, 1,    0,    0,    0, 0, 1, 0, 0, 1, 1, 0.5f, 0, 2, 2, 2, 0};
+  uint16_t indices[2 + 6] = {0xffff, 0xffff, 0, 1, 2, 1, 3, 2};
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  VkAccelerationStructureBuildRangeInfoKHR range{2, 4, 2, 0};
+
+  Mesh() {
+    geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    auto& t = geometry.geometry.triangles;
+    t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+    t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+    t.vertexStride = 16;
+    t.maxVertex = 6;
+    t.indexType = VK_INDEX_TYPE_UINT16;
+    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    info.geometryCount = 1;
+    info.pGeometries = &geometry;
+  }
+};
+
+// The payload after the serialization header (two UUIDs, three sizes and the handles' addresses): what the
+// structure holds.
+std::vector<unsigned char> Payload(const std::vector<unsigned char>& serialized) {
+  uint64_t handles = 0;
+  std::memcpy(&handles, serialized.data() + 2 * VK_UUID_SIZE + 16, sizeof(handles));
+  const size_t header = 2 * VK_UUID_SIZE + 24 + 8 * handles;
+  return {serialized.begin() + static_cast<std::ptrdiff_t>(header), serialized.end()};
+}
+
+TEST_CASE("test driver: reports host commands and creates the device with them enabled") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &as};
+  vkGetPhysicalDeviceFeatures2(instance.FindRayTracingGpu(), &features);
+  CHECK(as.accelerationStructure == VK_TRUE);
+  CHECK(as.accelerationStructureHostCommands == VK_TRUE);
+  DriverDevice driver;  // vkkit throws if the device cannot be created
+  CHECK(driver.Build != nullptr);
+}
+
+TEST_CASE("test driver: a host build reads what the device build reads and builds the same structure") {
+  DriverDevice d;
+  Mesh host_mesh, device_mesh;
+  const auto sizes = d.Sizes(host_mesh.info, 2);
+  auto host_as = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                      sizes.accelerationStructureSize);
+  auto device_as = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                        sizes.accelerationStructureSize);
+  // Host: host addresses, host scratch.
+  std::vector<unsigned char> scratch(sizes.buildScratchSize);
+  auto& ht = host_mesh.geometry.geometry.triangles;
+  ht.vertexData.hostAddress = host_mesh.vertices;
+  ht.indexData.hostAddress = host_mesh.indices;
+  host_mesh.info.dstAccelerationStructure = host_as.handle;
+  host_mesh.info.scratchData.hostAddress = scratch.data();
+  const VkAccelerationStructureBuildRangeInfoKHR* host_range = &host_mesh.range;
+  REQUIRE(d.Build(d.vk, VK_NULL_HANDLE, 1, &host_mesh.info, &host_range) == VK_SUCCESS);
+  // Device: the same bytes in buffers.
+  auto vertices = d.device.CreateBuffer(sizeof(device_mesh.vertices),
+                                        VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  auto indices = d.device.CreateBuffer(sizeof(device_mesh.indices),
+                                       VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  auto device_scratch = d.device.CreateBuffer(sizes.buildScratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  std::memcpy(vertices.mapped, device_mesh.vertices, sizeof(device_mesh.vertices));
+  std::memcpy(indices.mapped, device_mesh.indices, sizeof(device_mesh.indices));
+  // The device twin names firstVertex through the vertex address (range firstVertex 0): lavapipe 25 adds a
+  // range's firstVertex twice, where the specification adds it once.
+  auto& dt = device_mesh.geometry.geometry.triangles;
+  dt.vertexData.deviceAddress = vertices.address + device_mesh.range.firstVertex * dt.vertexStride;
+  device_mesh.range.firstVertex = 0;
+  dt.indexData.deviceAddress = indices.address;
+  device_mesh.info.dstAccelerationStructure = device_as.handle;
+  device_mesh.info.scratchData.deviceAddress = device_scratch.address;
+  d.device.OneShot([&](VkCommandBuffer cb) {
+    const VkAccelerationStructureBuildRangeInfoKHR* range = &device_mesh.range;
+    d.device.CmdBuildAccelerationStructuresKHR(cb, 1, &device_mesh.info, &range);
+  });
+
+  const auto host_bytes = d.Serialize(host_as.handle);
+  const auto device_bytes = d.Serialize(device_as.handle);
+  REQUIRE(host_bytes.size() == device_bytes.size());
+  CHECK(Payload(host_bytes) == Payload(device_bytes));
+  CHECK(d.Property(host_as.handle, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR) ==
+        d.Property(device_as.handle, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR));
+
+  // A vertex the device build does not read changes nothing; one it reads changes the structure.
+  Mesh other;
+  other.vertices[0] = -5;  // before firstVertex
+  other.geometry.geometry.triangles.vertexData.hostAddress = other.vertices;
+  other.geometry.geometry.triangles.indexData.hostAddress = other.indices;
+  other.info.dstAccelerationStructure = host_as.handle;
+  other.info.scratchData.hostAddress = scratch.data();
+  const VkAccelerationStructureBuildRangeInfoKHR* other_range = &other.range;
+  REQUIRE(d.Build(d.vk, VK_NULL_HANDLE, 1, &other.info, &other_range) == VK_SUCCESS);
+  CHECK(Payload(d.Serialize(host_as.handle)) == Payload(device_bytes));
+  other.vertices[4 * 5 + 2] = 7;  // vertex 3 (index 3 + firstVertex 2), read by the second triangle
+  REQUIRE(d.Build(d.vk, VK_NULL_HANDLE, 1, &other.info, &other_range) == VK_SUCCESS);
+  CHECK(Payload(d.Serialize(host_as.handle)) != Payload(device_bytes));
+
+  d.device.Destroy(vertices);
+  d.device.Destroy(indices);
+  d.device.Destroy(device_scratch);
+  d.device.Destroy(host_as);
+  d.device.Destroy(device_as);
+}
+
+TEST_CASE("test driver: a deferred host build runs when joined; host copies and deserialization round-trip") {
+  DriverDevice d;
+  Mesh mesh;
+  const auto sizes = d.Sizes(mesh.info, 2);
+  auto as = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                 sizes.accelerationStructureSize);
+  std::vector<unsigned char> scratch(sizes.buildScratchSize);
+  mesh.geometry.geometry.triangles.vertexData.hostAddress = mesh.vertices;
+  mesh.geometry.geometry.triangles.indexData.hostAddress = mesh.indices;
+  mesh.info.dstAccelerationStructure = as.handle;
+  mesh.info.scratchData.hostAddress = scratch.data();
+  const VkAccelerationStructureBuildRangeInfoKHR* range = &mesh.range;
+
+  auto create = Load<PFN_vkCreateDeferredOperationKHR>(d.vk, "vkCreateDeferredOperationKHR");
+  auto join = Load<PFN_vkDeferredOperationJoinKHR>(d.vk, "vkDeferredOperationJoinKHR");
+  auto result = Load<PFN_vkGetDeferredOperationResultKHR>(d.vk, "vkGetDeferredOperationResultKHR");
+  auto destroy = Load<PFN_vkDestroyDeferredOperationKHR>(d.vk, "vkDestroyDeferredOperationKHR");
+  VkDeferredOperationKHR operation = VK_NULL_HANDLE;
+  REQUIRE(create(d.vk, nullptr, &operation) == VK_SUCCESS);
+  REQUIRE(d.Build(d.vk, operation, 1, &mesh.info, &range) == VK_OPERATION_DEFERRED_KHR);
+  CHECK(result(d.vk, operation) == VK_NOT_READY);
+  CHECK(join(d.vk, operation) == VK_SUCCESS);
+  CHECK(result(d.vk, operation) == VK_SUCCESS);
+  CHECK(join(d.vk, operation) == VK_THREAD_DONE_KHR);
+  destroy(d.vk, operation, nullptr);
+  const auto built = d.Serialize(as.handle);
+  CHECK(d.Property(as.handle, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR) != 0);
+
+  // Serialized bytes into a new structure, and a host clone: both serialize as the original.
+  auto restored = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                       sizes.accelerationStructureSize);
+  VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+  from.src.hostAddress = built.data();
+  from.dst = restored.handle;
+  from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+  REQUIRE(d.FromMemory(d.vk, VK_NULL_HANDLE, &from) == VK_SUCCESS);
+  CHECK(Payload(d.Serialize(restored.handle)) == Payload(built));
+  auto clone = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                    sizes.accelerationStructureSize);
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = as.handle;
+  copy.dst = clone.handle;
+  copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+  REQUIRE(d.Copy(d.vk, VK_NULL_HANDLE, &copy) == VK_SUCCESS);
+  CHECK(Payload(d.Serialize(clone.handle)) == Payload(built));
+  d.device.Destroy(clone);
+  d.device.Destroy(restored);
+  d.device.Destroy(as);
+}
+
+}  // namespace
