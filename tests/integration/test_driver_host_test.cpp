@@ -1,0 +1,53 @@
+// Family "host" on asval's test driver (docs/testing.md): host builds that reach a driver which executes them.
+// The layers of the run (asval, and the Khronos layer in self-validation runs) sit above the test driver.
+#include <catch2/catch_test_macros.hpp>
+
+#include <cstring>
+
+#include "host_build_helpers.h"
+#include "on_test_driver.h"
+
+namespace asval_test {
+namespace {
+
+// What the device says of the structure once the host build has run: a built structure has a serialized size.
+uint64_t SerializedSize(vkkit::Device& device, VkAccelerationStructureKHR structure) {
+  auto write = reinterpret_cast<PFN_vkWriteAccelerationStructuresPropertiesKHR>(
+      vkGetDeviceProcAddr(device.handle(), "vkWriteAccelerationStructuresPropertiesKHR"));
+  uint64_t size = 0;
+  vkkit::Check(write(device.handle(), 1, &structure, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR,
+                     sizeof(size), &size, sizeof(size)),
+               "vkWriteAccelerationStructuresPropertiesKHR");
+  return size;
+}
+
+TEST_CASE("03581 valid twin on the test driver: host builds with accelerationStructureHostCommands stay silent "
+          "and execute",
+          "[integration][host][test-driver][valid]") {
+  const OnTestDriver driver;
+  CheckFixture f("host", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  Scene scene(device);
+  for (const auto& geometry : {scene.Triangles(), scene.IndexedTriangles(VK_INDEX_TYPE_UINT32),
+                               scene.IndexedTriangles(VK_INDEX_TYPE_UINT16), scene.Aabbs(), scene.Instances()}) {
+    HostBuild build(scene, geometry);
+    REQUIRE(CallHostBuild(device, {build.info}, {&build.range}) == VK_SUCCESS);
+    CHECK(SerializedSize(device, build.info.dstAccelerationStructure) != 0);
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("03581 on the test driver: a host build on a device that did not enable the feature is reported",
+          "[integration][host][test-driver][03581]") {
+  const OnTestDriver driver;
+  CheckFixture f("features");  // the driver offers host commands; this device does not enable them
+  vkkit::Device& device = f.device();
+  Scene scene(device);
+  HostBuild build(scene, scene.Triangles());
+  f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581");
+  build.Call(device);
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test
