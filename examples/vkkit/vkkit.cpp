@@ -101,6 +101,7 @@ Device::Device(const Instance& instance, VkPhysicalDevice gpu, const DeviceOptio
       has_ray_query ? static_cast<void*>(&ray_query) : static_cast<void*>(&pipeline)};
   as_features.accelerationStructure = VK_TRUE;
   as_features.accelerationStructureHostCommands = options.host_commands ? VK_TRUE : VK_FALSE;
+  as_features.accelerationStructureIndirectBuild = options.indirect_build ? VK_TRUE : VK_FALSE;
   ray_query.pNext = options.features;  // the caller's own feature structures, after these
   pipeline.pNext = options.features;
   VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &as_features};

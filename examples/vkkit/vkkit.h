@@ -57,6 +57,7 @@ struct DeviceOptions {
   bool timeline_semaphore = false;  // VkPhysicalDeviceVulkan12Features::timelineSemaphore
   uint32_t queue_count = 1;         // queues of the chosen family, at most what it offers (queue_count())
   bool host_commands = false;  // VkPhysicalDeviceAccelerationStructureFeaturesKHR::accelerationStructureHostCommands
+  bool indirect_build = false;  // VkPhysicalDeviceAccelerationStructureFeaturesKHR::accelerationStructureIndirectBuild
 };
 
 // Whether the physical device has a device extension.

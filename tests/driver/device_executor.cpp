@@ -81,7 +81,7 @@ VkResult DeviceExecutor::Prepare() {
   return vk.CreateFence(device_.device, &fence, nullptr, &fence_);
 }
 
-VkResult DeviceExecutor::Run(const std::function<void(VkCommandBuffer)>& record) {
+VkResult DeviceExecutor::Run(const std::function<void(VkCommandBuffer)>& record, bool queue_locked) {
   std::lock_guard<std::mutex> lock(lock_);
   VkResult result = Prepare();
   if (result != VK_SUCCESS) return result;
@@ -104,7 +104,9 @@ VkResult DeviceExecutor::Run(const std::function<void(VkCommandBuffer)>& record)
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &command_buffer_;
-  {
+  if (queue_locked) {
+    result = vk.QueueSubmit(queue_, 1, &submit, fence_);
+  } else {
     std::lock_guard<std::mutex> queue(device_.queue_lock);
     result = vk.QueueSubmit(queue_, 1, &submit, fence_);
   }

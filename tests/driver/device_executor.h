@@ -30,8 +30,9 @@ class DeviceExecutor {
   VkResult CreateStaging(VkDeviceSize bytes, StagingBuffer* out);
   void DestroyStaging(StagingBuffer* buffer);
 
-  // Records `record` into the driver's command buffer, submits it and waits for it.
-  VkResult Run(const std::function<void(VkCommandBuffer)>& record);
+  // Records `record` into the driver's command buffer, submits it and waits for it. `queue_locked`: the caller
+  // holds the device's queue lock already (the test driver's submission hooks).
+  VkResult Run(const std::function<void(VkCommandBuffer)>& record, bool queue_locked = false);
 
  private:
   VkResult Prepare();  // the pool, command buffer and fence, at first use

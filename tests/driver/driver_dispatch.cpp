@@ -3,7 +3,9 @@
 #include <unordered_map>
 
 #include "deferred_operations.h"
+#include "device_buffers.h"
 #include "device_executor.h"
+#include "indirect_builds.h"
 
 namespace asval_test_driver {
 namespace {

@@ -11,6 +11,8 @@ namespace asval_test_driver {
 
 class DeviceExecutor;
 class DeferredOperations;
+class DeviceBuffers;
+class IndirectBuilds;
 
 struct InstanceData {
   VkInstance instance = VK_NULL_HANDLE;
@@ -36,7 +38,8 @@ struct DeviceFunctions {
   X(CmdBuildAccelerationStructuresKHR) X(GetAccelerationStructureBuildSizesKHR)                           \
   X(GetAccelerationStructureDeviceAddressKHR) X(CmdCopyAccelerationStructureKHR)                          \
   X(CmdCopyAccelerationStructureToMemoryKHR) X(CmdCopyMemoryToAccelerationStructureKHR)                   \
-  X(CmdWriteAccelerationStructuresPropertiesKHR) X(DestroyDeferredOperationKHR)
+  X(CmdWriteAccelerationStructuresPropertiesKHR) X(DestroyDeferredOperationKHR)                          \
+  X(ResetCommandBuffer) X(CmdExecuteCommands) X(CmdCopyBuffer) X(BindBufferMemory2)
 // clang-format on
 #define ASVAL_DRIVER_DECLARE(name) PFN_vk##name name = nullptr;
   ASVAL_DRIVER_DEVICE_FUNCTIONS(ASVAL_DRIVER_DECLARE)
@@ -54,6 +57,8 @@ struct DeviceData {
   std::mutex queue_lock;
   std::unique_ptr<DeviceExecutor> executor;
   std::unique_ptr<DeferredOperations> deferred;
+  std::unique_ptr<DeviceBuffers> buffers;
+  std::unique_ptr<IndirectBuilds> indirect;
 };
 
 void* DispatchKey(const void* handle);

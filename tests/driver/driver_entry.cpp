@@ -3,11 +3,14 @@
 // executes itself. Everything else goes down the chain unchanged.
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "deferred_operations.h"
+#include "device_buffers.h"
 #include "device_executor.h"
 #include "driver_dispatch.h"
 #include "host_commands.h"
+#include "indirect_builds.h"
 
 #define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
 
@@ -18,8 +21,9 @@ namespace {
 void AddFeatures(void* chain) {
   for (auto* s = static_cast<VkBaseOutStructure*>(chain); s != nullptr; s = s->pNext) {
     if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR) {
-      reinterpret_cast<VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(s)->accelerationStructureHostCommands =
-          VK_TRUE;
+      auto* as = reinterpret_cast<VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(s);
+      as->accelerationStructureHostCommands = VK_TRUE;
+      as->accelerationStructureIndirectBuild = VK_TRUE;
     }
   }
 }
@@ -88,12 +92,16 @@ struct HiddenFeatures {
       if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR) {
         as_ = reinterpret_cast<VkPhysicalDeviceAccelerationStructureFeaturesKHR*>(const_cast<VkBaseInStructure*>(s));
         host_commands_ = as_->accelerationStructureHostCommands;
+        indirect_build_ = as_->accelerationStructureIndirectBuild;
         as_->accelerationStructureHostCommands = VK_FALSE;
+        as_->accelerationStructureIndirectBuild = VK_FALSE;
       }
     }
   }
   ~HiddenFeatures() {
-    if (as_ != nullptr) as_->accelerationStructureHostCommands = host_commands_;
+    if (as_ == nullptr) return;
+    as_->accelerationStructureHostCommands = host_commands_;
+    as_->accelerationStructureIndirectBuild = indirect_build_;
   }
   HiddenFeatures(const HiddenFeatures&) = delete;
   HiddenFeatures& operator=(const HiddenFeatures&) = delete;
@@ -101,6 +109,7 @@ struct HiddenFeatures {
  private:
   VkPhysicalDeviceAccelerationStructureFeaturesKHR* as_ = nullptr;
   VkBool32 host_commands_ = VK_FALSE;
+  VkBool32 indirect_build_ = VK_FALSE;
 };
 
 VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDeviceCreateInfo* info,
@@ -131,13 +140,16 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   device->queue_family = info->queueCreateInfoCount != 0 ? info->pQueueCreateInfos[0].queueFamilyIndex : 0;
   device->executor = std::make_unique<DeviceExecutor>(*device);
   device->deferred = std::make_unique<DeferredOperations>();
+  device->buffers = std::make_unique<DeviceBuffers>();
+  device->indirect = std::make_unique<IndirectBuilds>(*device);
   return VK_SUCCESS;
 }
 
 VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice handle, const VkAllocationCallbacks* allocator) {
   DeviceData* device = FindDevice(handle);
   if (device == nullptr) return;
-  device->executor.reset();  // its pool and fence belong to the device
+  device->indirect.reset();  // their pools and fence belong to the device
+  device->executor.reset();
   const PFN_vkDestroyDevice destroy = device->vk.DestroyDevice;
   RemoveDevice(handle);
   destroy(handle, allocator);
@@ -145,17 +157,84 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice handle, const VkAllocationCall
 
 // Queues are externally synchronized: the application's submissions and waits take the lock the test driver's
 // own submissions take.
+// Indirect builds read their ranges when their submission reaches the test driver (indirect_builds.h).
 VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t count, const VkSubmitInfo* submits, VkFence fence) {
   DeviceData* device = FindDevice(queue);
+  std::vector<VkCommandBuffer> command_buffers;
+  for (uint32_t i = 0; i < count; ++i) {
+    command_buffers.insert(command_buffers.end(), submits[i].pCommandBuffers,
+                           submits[i].pCommandBuffers + submits[i].commandBufferCount);
+  }
   std::lock_guard<std::mutex> lock(device->queue_lock);
+  const VkResult prepared = device->indirect->Prepare(queue, command_buffers);
+  if (prepared != VK_SUCCESS) return prepared;
   return device->vk.QueueSubmit(queue, count, submits, fence);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t count, const VkSubmitInfo2* submits,
                                             VkFence fence) {
   DeviceData* device = FindDevice(queue);
+  std::vector<VkCommandBuffer> command_buffers;
+  for (uint32_t i = 0; i < count; ++i) {
+    for (uint32_t c = 0; c < submits[i].commandBufferInfoCount; ++c) {
+      command_buffers.push_back(submits[i].pCommandBufferInfos[c].commandBuffer);
+    }
+  }
   std::lock_guard<std::mutex> lock(device->queue_lock);
+  const VkResult prepared = device->indirect->Prepare(queue, command_buffers);
+  if (prepared != VK_SUCCESS) return prepared;
   return device->vk.QueueSubmit2(queue, count, submits, fence);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer command_buffer,
+                                                  const VkCommandBufferBeginInfo* info) {
+  DeviceData* device = FindDevice(command_buffer);
+  device->indirect->Begin(command_buffer);
+  return device->vk.BeginCommandBuffer(command_buffer, info);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
+    VkCommandBuffer command_buffer, uint32_t count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+    const VkDeviceAddress* addresses, const uint32_t* strides, const uint32_t* const* max_counts) {
+  FindDevice(command_buffer)->indirect->Record(command_buffer, count, infos, addresses, strides, max_counts);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice handle, const VkBufferCreateInfo* info,
+                                            const VkAllocationCallbacks* allocator, VkBuffer* buffer) {
+  DeviceData* device = FindDevice(handle);
+  const VkResult result = device->vk.CreateBuffer(handle, info, allocator, buffer);
+  if (result == VK_SUCCESS) device->buffers->Created(*buffer, *info);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice handle, VkBuffer buffer, const VkAllocationCallbacks* allocator) {
+  DeviceData* device = FindDevice(handle);
+  device->buffers->Destroyed(buffer);
+  device->vk.DestroyBuffer(handle, buffer, allocator);
+}
+
+void BufferBound(DeviceData* device, VkBuffer buffer) {
+  if (!device->buffers->HasAddress(buffer)) return;
+  VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+  info.buffer = buffer;
+  device->buffers->Bound(buffer, device->vk.GetBufferDeviceAddress(device->device, &info));
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BindBufferMemory(VkDevice handle, VkBuffer buffer, VkDeviceMemory memory,
+                                                VkDeviceSize offset) {
+  DeviceData* device = FindDevice(handle);
+  const VkResult result = device->vk.BindBufferMemory(handle, buffer, memory, offset);
+  if (result == VK_SUCCESS) BufferBound(device, buffer);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL BindBufferMemory2(VkDevice handle, uint32_t count, const VkBindBufferMemoryInfo* infos) {
+  DeviceData* device = FindDevice(handle);
+  const VkResult result = device->vk.BindBufferMemory2(handle, count, infos);
+  if (result == VK_SUCCESS) {
+    for (uint32_t i = 0; i < count; ++i) BufferBound(device, infos[i].buffer);
+  }
+  return result;
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
@@ -248,6 +327,13 @@ PFN_vkVoidFunction DeviceFunction(const char* name) {
   ASVAL_DRIVER_HOOK(GetDeferredOperationResultKHR)
   ASVAL_DRIVER_HOOK(GetDeferredOperationMaxConcurrencyKHR)
   ASVAL_DRIVER_HOOK(DestroyDeferredOperationKHR)
+  ASVAL_DRIVER_HOOK(BeginCommandBuffer)
+  ASVAL_DRIVER_HOOK(CmdBuildAccelerationStructuresIndirectKHR)
+  ASVAL_DRIVER_HOOK(CreateBuffer)
+  ASVAL_DRIVER_HOOK(DestroyBuffer)
+  ASVAL_DRIVER_HOOK(BindBufferMemory)
+  ASVAL_DRIVER_HOOK(BindBufferMemory2)
+  if (std::strcmp(name, "vkBindBufferMemory2KHR") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&BindBufferMemory2);
   if (std::strcmp(name, "vkQueueSubmit2KHR") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&QueueSubmit2);
   return nullptr;
 }

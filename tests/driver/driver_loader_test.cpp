@@ -33,6 +33,7 @@ struct DriverDevice {
   static vkkit::DeviceOptions Options() {
     vkkit::DeviceOptions options;
     options.host_commands = true;
+    options.indirect_build = true;
     return options;
   }
 
@@ -95,7 +96,7 @@ std::vector<unsigned char> Payload(const std::vector<unsigned char>& serialized)
   return {serialized.begin() + static_cast<std::ptrdiff_t>(header), serialized.end()};
 }
 
-TEST_CASE("test driver: reports host commands and creates the device with them enabled") {
+TEST_CASE("test driver: reports host commands and indirect builds and creates the device with them enabled") {
   vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
   VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
@@ -103,6 +104,7 @@ TEST_CASE("test driver: reports host commands and creates the device with them e
   vkGetPhysicalDeviceFeatures2(instance.FindRayTracingGpu(), &features);
   CHECK(as.accelerationStructure == VK_TRUE);
   CHECK(as.accelerationStructureHostCommands == VK_TRUE);
+  CHECK(as.accelerationStructureIndirectBuild == VK_TRUE);
   DriverDevice driver;  // vkkit throws if the device cannot be created
   CHECK(driver.Build != nullptr);
 }
@@ -221,6 +223,87 @@ TEST_CASE("test driver: a deferred host build runs when joined; host copies and 
   d.device.Destroy(clone);
   d.device.Destroy(restored);
   d.device.Destroy(as);
+}
+
+TEST_CASE("test driver: an indirect build reads its ranges from memory when its submission is made") {
+  DriverDevice d;
+  auto indirect =
+      Load<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(d.vk, "vkCmdBuildAccelerationStructuresIndirectKHR");
+  REQUIRE(indirect != nullptr);
+  Mesh mesh;
+  const auto sizes = d.Sizes(mesh.info, 2);
+  auto vertices = d.device.CreateBuffer(sizeof(mesh.vertices),
+                                        VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  auto indices =
+      d.device.CreateBuffer(sizeof(mesh.indices), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  auto scratch = d.device.CreateBuffer(sizes.buildScratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto ranges = d.device.CreateBuffer(64, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  std::memcpy(vertices.mapped, mesh.vertices, sizeof(mesh.vertices));
+  std::memcpy(indices.mapped, mesh.indices, sizeof(mesh.indices));
+  auto& t = mesh.geometry.geometry.triangles;
+  t.vertexData.deviceAddress = vertices.address;
+  t.indexData.deviceAddress = indices.address;
+  auto built = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                    sizes.accelerationStructureSize);
+  auto direct = d.device.CreateAccelerationStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                                     sizes.accelerationStructureSize);
+  mesh.info.scratchData.deviceAddress = scratch.address;
+
+  // One command buffer holding the indirect build, recorded once, submitted twice.
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  VkCommandPool pool = VK_NULL_HANDLE;
+  REQUIRE(vkCreateCommandPool(d.vk, &pool_info, nullptr, &pool) == VK_SUCCESS);
+  VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  allocate.commandPool = pool;
+  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  allocate.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  REQUIRE(vkAllocateCommandBuffers(d.vk, &allocate, &cb) == VK_SUCCESS);
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  REQUIRE(vkBeginCommandBuffer(cb, &begin) == VK_SUCCESS);
+  VkAccelerationStructureBuildGeometryInfoKHR info = mesh.info;
+  info.dstAccelerationStructure = built.handle;
+  const uint32_t max_count = 2;
+  const uint32_t* max_counts = &max_count;
+  const uint32_t stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
+  indirect(cb, 1, &info, &ranges.address, &stride, &max_counts);
+  REQUIRE(vkEndCommandBuffer(cb) == VK_SUCCESS);
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  REQUIRE(vkCreateFence(d.vk, &fence_info, nullptr, &fence) == VK_SUCCESS);
+
+  for (uint32_t count : {1u, 2u}) {
+    // The ranges as the device reads them: written by the host before this submission.
+    const VkAccelerationStructureBuildRangeInfoKHR range{count, 4, 2, 0};
+    std::memcpy(ranges.mapped, &range, sizeof(range));
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    REQUIRE(vkQueueSubmit(d.device.queue(), 1, &submit, fence) == VK_SUCCESS);
+    REQUIRE(vkWaitForFences(d.vk, 1, &fence, VK_TRUE, UINT64_MAX) == VK_SUCCESS);
+    REQUIRE(vkResetFences(d.vk, 1, &fence) == VK_SUCCESS);
+    // The direct twin: the same count, firstVertex through the vertex address (lavapipe adds it twice).
+    VkAccelerationStructureGeometryKHR geometry = mesh.geometry;
+    geometry.geometry.triangles.vertexData.deviceAddress = vertices.address + 2 * t.vertexStride;
+    VkAccelerationStructureBuildGeometryInfoKHR twin = mesh.info;
+    twin.pGeometries = &geometry;
+    twin.dstAccelerationStructure = direct.handle;
+    const VkAccelerationStructureBuildRangeInfoKHR twin_range{count, 4, 0, 0};
+    d.device.OneShot([&](VkCommandBuffer one) {
+      const VkAccelerationStructureBuildRangeInfoKHR* r = &twin_range;
+      d.device.CmdBuildAccelerationStructuresKHR(one, 1, &twin, &r);
+    });
+    CAPTURE(count);
+    CHECK(Payload(d.Serialize(built.handle)) == Payload(d.Serialize(direct.handle)));
+  }
+  vkDestroyFence(d.vk, fence, nullptr);
+  vkDestroyCommandPool(d.vk, pool, nullptr);
+  d.device.Destroy(built);
+  d.device.Destroy(direct);
+  d.device.Destroy(ranges);
+  d.device.Destroy(scratch);
+  d.device.Destroy(indices);
+  d.device.Destroy(vertices);
 }
 
 }  // namespace
