@@ -1,7 +1,6 @@
 // Family "host" on asval's test driver (docs/testing.md): host builds that reach a driver which executes them.
 // The layers of the run (asval, and the Khronos layer in self-validation runs) sit above the test driver.
 #include <catch2/catch_test_macros.hpp>
-
 #include <cstring>
 
 #include "host_build_helpers.h"
@@ -21,9 +20,10 @@ uint64_t SerializedSize(vkkit::Device& device, VkAccelerationStructureKHR struct
   return size;
 }
 
-TEST_CASE("03581 valid twin on the test driver: host builds with accelerationStructureHostCommands stay silent "
-          "and execute",
-          "[integration][host][test-driver][valid]") {
+TEST_CASE(
+    "03581 valid twin on the test driver: host builds with accelerationStructureHostCommands stay silent "
+    "and execute",
+    "[integration][host][test-driver][valid]") {
   const OnTestDriver driver;
   CheckFixture f("host", OnTestDriver::HostCommands());
   vkkit::Device& device = f.device();
