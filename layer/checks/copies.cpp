@@ -174,4 +174,51 @@ bool ValidateWriteProperties(const CheckContext& ctx, const char* function, VkCo
   return skip;
 }
 
+namespace {
+
+// What each property query type asks of the host command's stride and pData (a VkDeviceSize per structure).
+struct PropertyDataRules {
+  const char* stride;
+  const char* data;
+};
+
+PropertyDataRules DataRulesFor(VkQueryType type) {
+  switch (type) {
+    case VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR: return {"queryType-03448", "queryType-03449"};
+    case VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR: return {"queryType-03450", "queryType-03451"};
+    case VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR: return {"queryType-06731", "queryType-06732"};
+    case VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_BOTTOM_LEVEL_POINTERS_KHR:
+      return {"queryType-06733", "queryType-06734"};
+    default: return {nullptr, nullptr};  // queryType-06742's
+  }
+}
+
+}  // namespace
+
+bool ValidateHostPropertyData(const CheckContext& ctx, const char* function, uint32_t count, VkQueryType type,
+                              size_t data_size, const void* data, size_t stride) {
+  const Location root(function);
+  bool skip = false;
+  const PropertyDataRules rules = DataRulesFor(type);
+  if (rules.stride && stride % sizeof(VkDeviceSize) != 0) {
+    skip |= Report(ctx, VK_NULL_HANDLE, VK_NULL_HANDLE, VuidName{function, rules.stride}, root.Field("stride"),
+                   "({}) is not a multiple of sizeof(VkDeviceSize) (8), as queryType {} requires.", stride,
+                   string_VkQueryType(type));
+  }
+  // Nothing is written for no structure; where something is, each value is a VkDeviceSize, which a null or
+  // misaligned pointer cannot hold. (That the bytes are the app's, writable, the layer cannot see.)
+  const auto address = reinterpret_cast<uintptr_t>(data);
+  if (rules.data && count != 0 && (data == nullptr || address % alignof(VkDeviceSize) != 0)) {
+    skip |= Report(ctx, VK_NULL_HANDLE, VK_NULL_HANDLE, VuidName{function, rules.data}, root.Field("pData"),
+                   "({}) does not point to a VkDeviceSize: {}, as queryType {} requires.", fmt::ptr(data),
+                   data == nullptr ? "it is null" : "it is not aligned to 8 bytes", string_VkQueryType(type));
+  }
+  if (uint64_t{count} * stride > data_size) {
+    skip |= Report(ctx, VK_NULL_HANDLE, VK_NULL_HANDLE, VuidName{function, "dataSize-03452"}, root.Field("dataSize"),
+                   "({}) is less than accelerationStructureCount ({}) times stride ({}), {}.", data_size, count, stride,
+                   uint64_t{count} * stride);
+  }
+  return skip;
+}
+
 }  // namespace asval

@@ -6,7 +6,9 @@
 //   VkCopyAccelerationStructureToMemoryInfoKHR: mode-03412; vkCmdCopyAccelerationStructureToMemoryKHR-pInfo-03740
 //   VkCopyMemoryToAccelerationStructureInfoKHR: mode-03413; vkCmdCopyMemoryToAccelerationStructureKHR-pInfo-03743
 //   vkCmdWriteAccelerationStructuresPropertiesKHR: queryType-06742, queryPool-02493, query-04880, buffer-03736
-//   vkWriteAccelerationStructuresPropertiesKHR: queryType-06742
+//   vkWriteAccelerationStructuresPropertiesKHR: queryType-06742; stride and pData per query type (03448 / 03449
+//   compacted size, 03450 / 03451 serialization size, 06731 / 06732 size, 06733 / 06734 bottom-level pointers),
+//   dataSize-03452
 // (dst-03561 needs the source's serialization size for its current contents: checked at submission, see
 // update_rules.h.)
 #include <vulkan/vulkan.h>
@@ -26,5 +28,8 @@ bool ValidateCopyMemoryToInfo(const CheckContext& ctx, const char* function, VkC
 bool ValidateWriteProperties(const CheckContext& ctx, const char* function, VkCommandBuffer cb, uint32_t count,
                              const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
                              uint32_t first_query);
+// vkWriteAccelerationStructuresPropertiesKHR's host data: stride and pData as the query type requires, dataSize.
+bool ValidateHostPropertyData(const CheckContext& ctx, const char* function, uint32_t count, VkQueryType type,
+                              size_t data_size, const void* data, size_t stride);
 
 }  // namespace asval

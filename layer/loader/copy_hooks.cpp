@@ -3,6 +3,7 @@
 // buffer (device commands, applied at submission) or checked now and applied on completion (host commands).
 #include "copies.h"
 #include "history_host.h"
+#include "host_command_features.h"
 #include "history_recorder.h"
 #include "layer_data.h"
 #include "vk_intercepts.h"
@@ -14,11 +15,12 @@ namespace {
 
 // A host copy: record-time rules, history rules, the downcall, and its operations applied (or deferred).
 template <typename MakeOps, typename Validate, typename Downcall>
-VkResult HostCopy(DeviceData& data, const char* function, VkDeferredOperationKHR deferred, MakeOps&& make_ops,
-                  Validate&& validate, Downcall&& downcall) {
+VkResult HostCopy(DeviceData& data, const char* function, const char* feature_vuid, VkDeferredOperationKHR deferred,
+                  MakeOps&& make_ops, Validate&& validate, Downcall&& downcall) {
   const CheckContext ctx = MakeCheckContext(data);
   const ProtectScope protect(data.reporter->protects());
-  bool skip = ctx.Enabled(kCheckCopies) && validate(ctx);
+  bool skip = ctx.Enabled(kCheckFeatures) && ValidateHostCommandFeature(ctx, function, feature_vuid);
+  skip |= ctx.Enabled(kCheckCopies) && validate(ctx);
   OpBatch batch;
   if (data.state.history_tracked) batch = make_ops();
   skip |= ValidateHostOps(ctx, batch, function);
@@ -109,7 +111,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkD
   const char* function = "vkCopyAccelerationStructureKHR";
   if (!pInfo) return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo);
   return HostCopy(
-      *data, function, deferredOperation, [&] { return HostCopyOps(*pInfo); },
+      *data, function, "accelerationStructureHostCommands-03582", deferredOperation,
+      [&] { return HostCopyOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
       [&] { return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo); });
 }
@@ -121,7 +124,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
   const char* function = "vkCopyAccelerationStructureToMemoryKHR";
   if (!pInfo) return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo);
   return HostCopy(
-      *data, function, deferredOperation, [&] { return HostCopyToMemoryOps(*pInfo); },
+      *data, function, "accelerationStructureHostCommands-03584", deferredOperation,
+      [&] { return HostCopyToMemoryOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyToMemoryInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
       [&] { return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo); });
 }
@@ -133,7 +137,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyMemoryToAccelerationStructureKHR(
   const char* function = "vkCopyMemoryToAccelerationStructureKHR";
   if (!pInfo) return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo);
   return HostCopy(
-      *data, function, deferredOperation, [&] { return HostCopyMemoryToOps(*pInfo); },
+      *data, function, "accelerationStructureHostCommands-03583", deferredOperation,
+      [&] { return HostCopyMemoryToOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyMemoryToInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
       [&] { return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo); });
 }
@@ -145,9 +150,13 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
   const char* function = "vkWriteAccelerationStructuresPropertiesKHR";
   const CheckContext ctx = MakeCheckContext(*data);
   const ProtectScope protect(data->reporter->protects());
-  bool skip = ctx.Enabled(kCheckCopies) &&
-              ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount,
-                                      pAccelerationStructures, queryType, VK_NULL_HANDLE, 0);
+  bool skip = ctx.Enabled(kCheckFeatures) &&
+              ValidateHostCommandFeature(ctx, function, "accelerationStructureHostCommands-03585");
+  if (ctx.Enabled(kCheckCopies)) {
+    skip |= ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount, pAccelerationStructures,
+                                    queryType, VK_NULL_HANDLE, 0);
+    skip |= ValidateHostPropertyData(ctx, function, accelerationStructureCount, queryType, dataSize, pData, stride);
+  }
   if (data->state.history_tracked) {
     skip |= ValidateHostOps(ctx, HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType),
                             function);

@@ -1,0 +1,184 @@
+// The host copies and property writes through the loader on asval's test driver (docs/testing.md), which
+// executes them: their feature (family "features") and the data a property write fills (family "copies").
+#include <catch2/catch_test_macros.hpp>
+#include <cstring>
+#include <vector>
+
+#include "host_build_helpers.h"
+#include "on_test_driver.h"
+
+namespace asval_test {
+namespace {
+
+constexpr VkQueryType kCompacted = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR;
+constexpr VkQueryType kSerializationSize = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR;
+
+// The four host commands, loaded through the loader (the layers see them).
+struct HostCommands {
+  explicit HostCommands(VkDevice device)
+      : copy(reinterpret_cast<PFN_vkCopyAccelerationStructureKHR>(
+            vkGetDeviceProcAddr(device, "vkCopyAccelerationStructureKHR"))),
+        to_memory(reinterpret_cast<PFN_vkCopyAccelerationStructureToMemoryKHR>(
+            vkGetDeviceProcAddr(device, "vkCopyAccelerationStructureToMemoryKHR"))),
+        from_memory(reinterpret_cast<PFN_vkCopyMemoryToAccelerationStructureKHR>(
+            vkGetDeviceProcAddr(device, "vkCopyMemoryToAccelerationStructureKHR"))),
+        properties(reinterpret_cast<PFN_vkWriteAccelerationStructuresPropertiesKHR>(
+            vkGetDeviceProcAddr(device, "vkWriteAccelerationStructuresPropertiesKHR"))) {}
+  PFN_vkCopyAccelerationStructureKHR copy;
+  PFN_vkCopyAccelerationStructureToMemoryKHR to_memory;
+  PFN_vkCopyMemoryToAccelerationStructureKHR from_memory;
+  PFN_vkWriteAccelerationStructuresPropertiesKHR properties;
+};
+
+// A bottom-level structure built on the host (compactable, so that every query type applies) and two more
+// structures of its size to copy into.
+struct HostBuilt {
+  Scene scene;
+  HostBuild build;
+  VkAccelerationStructureKHR source;
+  VkAccelerationStructureKHR clone;
+  VkAccelerationStructureKHR restored;
+
+  explicit HostBuilt(vkkit::Device& device)
+      : scene(device), build(scene, scene.Triangles()), source(build.info.dstAccelerationStructure) {
+    build.info.flags |= VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+    REQUIRE(CallHostBuild(device, {build.info}, {&build.range}) == VK_SUCCESS);
+    clone = scene.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 1 << 16);
+    restored = scene.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 1 << 16);
+  }
+};
+
+TEST_CASE(
+    "03582 / 03583 / 03584 / 03585 valid twin on the test driver: host copies, serialization and property "
+    "writes with accelerationStructureHostCommands stay silent and execute",
+    "[integration][copies][features][test-driver][valid]") {
+  const OnTestDriver driver;
+  CheckFixture f(nullptr, OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+
+  // Both sizes into one array 16 bytes apart: dataSize is count * stride.
+  alignas(16) VkDeviceSize sizes[2][2] = {};
+  const VkAccelerationStructureKHR twice[2] = {built.source, built.source};
+  REQUIRE(host.properties(device.handle(), 2, twice, kSerializationSize, sizeof(sizes), &sizes[0][0], 16) ==
+          VK_SUCCESS);
+  REQUIRE(host.properties(device.handle(), 1, &built.source, kCompacted, 8, &sizes[0][1], 8) == VK_SUCCESS);
+  CHECK(sizes[0][0] != 0);
+  CHECK(sizes[0][0] == sizes[1][0]);
+  CHECK(sizes[0][1] != 0);
+
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = built.source;
+  copy.dst = built.clone;
+  copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+  CHECK(host.copy(device.handle(), VK_NULL_HANDLE, &copy) == VK_SUCCESS);
+
+  std::vector<VkDeviceSize> serialized(sizes[0][0] / sizeof(VkDeviceSize) + 1);  // 8-byte aligned host memory
+  VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+  to.src = built.source;
+  to.dst.hostAddress = serialized.data();
+  to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+  CHECK(host.to_memory(device.handle(), VK_NULL_HANDLE, &to) == VK_SUCCESS);
+  uint64_t serialized_size = 0;  // the header's own count: the device wrote it
+  std::memcpy(&serialized_size, reinterpret_cast<const unsigned char*>(serialized.data()) + 2 * VK_UUID_SIZE,
+              sizeof(serialized_size));
+  CHECK(serialized_size == sizes[0][0]);
+
+  VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+  from.src.hostAddress = serialized.data();
+  from.dst = built.restored;
+  from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+  CHECK(host.from_memory(device.handle(), VK_NULL_HANDLE, &from) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "03582 / 03583 / 03584 / 03585: host copies and property writes without accelerationStructureHostCommands "
+    "are reported",
+    "[integration][features][test-driver][03582][03583][03584][03585]") {
+  const OnTestDriver driver;
+  CheckFixture f("features");  // the driver offers host commands; this device does not enable them
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  Scene scene(device);
+  const VkAccelerationStructureKHR structure = scene.blas();
+  alignas(16) unsigned char bytes[256] = {};
+  SECTION("03582: vkCopyAccelerationStructureKHR") {
+    VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+    copy.src = structure;
+    copy.dst = structure;
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureKHR-accelerationStructureHostCommands-03582");
+    host.copy(device.handle(), VK_NULL_HANDLE, &copy);
+  }
+  SECTION("03583: vkCopyMemoryToAccelerationStructureKHR") {
+    VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+    from.src.hostAddress = bytes;
+    from.dst = structure;
+    from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyMemoryToAccelerationStructureKHR-accelerationStructureHostCommands-03583");
+    host.from_memory(device.handle(), VK_NULL_HANDLE, &from);
+  }
+  SECTION("03584: vkCopyAccelerationStructureToMemoryKHR") {
+    VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+    to.src = structure;
+    to.dst.hostAddress = bytes;
+    to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureToMemoryKHR-accelerationStructureHostCommands-03584");
+    host.to_memory(device.handle(), VK_NULL_HANDLE, &to);
+  }
+  SECTION("03585: vkWriteAccelerationStructuresPropertiesKHR") {
+    f.monitor().Expect("VUID-vkWriteAccelerationStructuresPropertiesKHR-accelerationStructureHostCommands-03585");
+    host.properties(device.handle(), 1, &structure, kSerializationSize, 8, bytes, 8);
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
+// Per query type: the VUIDs of its stride and of its pData.
+struct DataRules {
+  VkQueryType type;
+  const char* stride;
+  const char* data;
+};
+constexpr DataRules kDataRules[] = {
+    {kCompacted, "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-03448",
+     "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-03449"},
+    {kSerializationSize, "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-03450",
+     "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-03451"},
+    {VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR, "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-06731",
+     "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-06732"},
+    {VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_BOTTOM_LEVEL_POINTERS_KHR,
+     "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-06733",
+     "VUID-vkWriteAccelerationStructuresPropertiesKHR-queryType-06734"},
+};
+
+TEST_CASE(
+    "queryType-03448 to 06734 and dataSize-03452: host property writes whose stride, pData or dataSize the "
+    "query type forbids are reported",
+    "[integration][copies][test-driver][03448][03449][03450][03451][06731][06732][06733][06734][03452]") {
+  const OnTestDriver driver;
+  CheckFixture f("copies", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+  alignas(16) unsigned char data[64] = {};
+  for (const DataRules& rules : kDataRules) {
+    CAPTURE(rules.stride);
+    f.monitor().Expect(rules.stride);  // a stride of 12: not a multiple of 8
+    host.properties(device.handle(), 1, &built.source, rules.type, 12, data, 12);
+    CHECK(f.monitor().Verify() == "");
+    f.monitor().Expect(rules.data);  // 4 bytes into an 8-aligned array
+    host.properties(device.handle(), 1, &built.source, rules.type, 8, data + 4, 8);
+    CHECK(f.monitor().Verify() == "");
+    f.monitor().Expect(rules.data);  // no pointer at all
+    host.properties(device.handle(), 1, &built.source, rules.type, 8, nullptr, 8);
+    CHECK(f.monitor().Verify() == "");
+  }
+  f.monitor().Expect("VUID-vkWriteAccelerationStructuresPropertiesKHR-dataSize-03452");  // 2 * 16 > 24
+  const VkAccelerationStructureKHR twice[2] = {built.source, built.source};
+  host.properties(device.handle(), 2, twice, kSerializationSize, 24, data, 16);
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test
