@@ -3,6 +3,7 @@
 // buffer (device commands, applied at submission) or checked now and applied on completion (host commands).
 #include "copies.h"
 #include "history_host.h"
+#include "host_copy_rules.h"
 #include "host_command_features.h"
 #include "history_recorder.h"
 #include "layer_data.h"
@@ -13,14 +14,19 @@ namespace asval::hooks {
 
 namespace {
 
-// A host copy: record-time rules, history rules, the downcall, and its operations applied (or deferred).
-template <typename MakeOps, typename Validate, typename Downcall>
+// A host copy: its feature, record-time rules (copies family, then the host family's), history rules, the downcall,
+// and its operations applied (or deferred).
+template <typename MakeOps, typename Validate, typename ValidateHost, typename Downcall>
 VkResult HostCopy(DeviceData& data, const char* function, const char* feature_vuid, VkDeferredOperationKHR deferred,
-                  MakeOps&& make_ops, Validate&& validate, Downcall&& downcall) {
+                  MakeOps&& make_ops, Validate&& validate, ValidateHost&& validate_host, Downcall&& downcall) {
   const CheckContext ctx = MakeCheckContext(data);
   const ProtectScope protect(data.reporter->protects());
   bool skip = ctx.Enabled(kCheckFeatures) && ValidateHostCommandFeature(ctx, function, feature_vuid);
   skip |= ctx.Enabled(kCheckCopies) && validate(ctx);
+  if (ctx.Enabled(kCheckHost)) {
+    skip |= ValidateHostCopyDeferred(ctx, function, deferred);
+    skip |= validate_host(ctx);
+  }
   OpBatch batch;
   if (data.state.history_tracked) batch = make_ops();
   skip |= ValidateHostOps(ctx, batch, function);
@@ -114,6 +120,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkD
       *data, function, "accelerationStructureHostCommands-03582", deferredOperation,
       [&] { return HostCopyOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [](const CheckContext&) { return false; },
       [&] { return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo); });
 }
 
@@ -127,6 +134,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureToMemoryKHR(
       *data, function, "accelerationStructureHostCommands-03584", deferredOperation,
       [&] { return HostCopyToMemoryOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyToMemoryInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [&](const CheckContext& ctx) { return ValidateHostCopyToMemory(ctx, *pInfo); },
       [&] { return data->dispatch.CopyAccelerationStructureToMemoryKHR(device, deferredOperation, pInfo); });
 }
 
@@ -140,6 +148,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyMemoryToAccelerationStructureKHR(
       *data, function, "accelerationStructureHostCommands-03583", deferredOperation,
       [&] { return HostCopyMemoryToOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyMemoryToInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
+      [&](const CheckContext& ctx) { return ValidateHostCopyMemoryTo(ctx, *pInfo); },
       [&] { return data->dispatch.CopyMemoryToAccelerationStructureKHR(device, deferredOperation, pInfo); });
 }
 

@@ -60,6 +60,9 @@ VkResult CopyToMemoryOnHost(DeviceData& device, const VkCopyAccelerationStructur
 VkResult CopyFromMemoryOnHost(DeviceData& device, const VkCopyMemoryToAccelerationStructureInfoKHR& info) {
   uint64_t bytes = 0;
   std::memcpy(&bytes, static_cast<const unsigned char*>(info.src.hostAddress) + kSerializedSizeOffset, sizeof(bytes));
+  // Bytes that are no serialized structure (an invalid call the layers above let through): the driver below would
+  // read past them.
+  if (bytes < kSerializedSizeOffset + 3 * sizeof(uint64_t)) return VK_ERROR_UNKNOWN;
   StagingBuffer staging;
   VkResult result = device.executor->CreateStaging(bytes, &staging);
   if (result != VK_SUCCESS) return result;

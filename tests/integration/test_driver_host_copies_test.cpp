@@ -180,5 +180,111 @@ TEST_CASE(
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE(
+    "pInfo-03729 / 03732 / 03750 / 03751: host serialization addresses that are null or not aligned to 16 "
+    "bytes are reported",
+    "[integration][host][test-driver][03729][03732][03750][03751]") {
+  const OnTestDriver driver;
+  CheckFixture f("host", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+  alignas(16) unsigned char bytes[1 << 12] = {};
+  VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+  to.src = built.source;
+  to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+  VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+  from.dst = built.restored;
+  from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+  SECTION("03732: a null destination") {
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureToMemoryKHR-pInfo-03732");
+    host.to_memory(device.handle(), VK_NULL_HANDLE, &to);
+  }
+  SECTION("03751: a destination 8 bytes past a multiple of 16") {
+    to.dst.hostAddress = bytes + 8;
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureToMemoryKHR-pInfo-03751");
+    host.to_memory(device.handle(), VK_NULL_HANDLE, &to);
+  }
+  SECTION("03729: a null source") {
+    f.monitor().Expect("VUID-vkCopyMemoryToAccelerationStructureKHR-pInfo-03729");
+    host.from_memory(device.handle(), VK_NULL_HANDLE, &from);
+  }
+  SECTION("03750: a source 4 bytes past a multiple of 16") {
+    from.src.hostAddress = bytes + 4;
+    f.monitor().Expect("VUID-vkCopyMemoryToAccelerationStructureKHR-pInfo-03750");
+    host.from_memory(device.handle(), VK_NULL_HANDLE, &from);
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
+// A deferred operation of the device's, destroyed with the scope.
+struct DeferredOperation {
+  explicit DeferredOperation(VkDevice device)
+      : device_(device),
+        join(reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(
+            vkGetDeviceProcAddr(device, "vkDeferredOperationJoinKHR"))) {
+    auto create =
+        reinterpret_cast<PFN_vkCreateDeferredOperationKHR>(vkGetDeviceProcAddr(device, "vkCreateDeferredOperationKHR"));
+    vkkit::Check(create(device, nullptr, &handle), "vkCreateDeferredOperationKHR");
+  }
+  ~DeferredOperation() {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(
+        vkGetDeviceProcAddr(device_, "vkDestroyDeferredOperationKHR"));
+    destroy(device_, handle, nullptr);
+  }
+  DeferredOperation(const DeferredOperation&) = delete;
+  DeferredOperation& operator=(const DeferredOperation&) = delete;
+
+  VkDevice device_;
+  PFN_vkDeferredOperationJoinKHR join;
+  VkDeferredOperationKHR handle = VK_NULL_HANDLE;
+};
+
+TEST_CASE(
+    "deferredOperation-03678: host copies on a deferred operation still running an earlier host copy are "
+    "reported; joined first, they stay silent",
+    "[integration][host][test-driver][03678]") {
+  const OnTestDriver driver;
+  // The layer follows deferred operations in its history records: the history family is on too.
+  CheckFixture f("host,history", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+  DeferredOperation operation(device.handle());
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = built.source;
+  copy.dst = built.clone;
+  copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+  // The test driver defers for real: the clone runs when the operation is joined.
+  REQUIRE(host.copy(device.handle(), operation.handle, &copy) == VK_OPERATION_DEFERRED_KHR);
+  alignas(16) unsigned char bytes[1 << 12] = {};
+  SECTION("vkCopyAccelerationStructureKHR") {
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureKHR-deferredOperation-03678");
+    host.copy(device.handle(), operation.handle, &copy);
+  }
+  SECTION("vkCopyAccelerationStructureToMemoryKHR") {
+    VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+    to.src = built.source;
+    to.dst.hostAddress = bytes;
+    to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureToMemoryKHR-deferredOperation-03678");
+    host.to_memory(device.handle(), operation.handle, &to);
+  }
+  SECTION("vkCopyMemoryToAccelerationStructureKHR") {
+    VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+    from.src.hostAddress = bytes;
+    from.dst = built.restored;
+    from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyMemoryToAccelerationStructureKHR-deferredOperation-03678");
+    host.from_memory(device.handle(), operation.handle, &from);
+  }
+  SECTION("valid twin: joined, then used again") {
+    REQUIRE(operation.join(device.handle(), operation.handle) == VK_SUCCESS);
+    REQUIRE(host.copy(device.handle(), operation.handle, &copy) == VK_OPERATION_DEFERRED_KHR);
+  }
+  CHECK(f.monitor().Verify() == "");
+  operation.join(device.handle(), operation.handle);  // the deferred clone runs before the structures go
+}
+
 }  // namespace
 }  // namespace asval_test
