@@ -19,6 +19,7 @@
 #include "history_helpers.h"
 #include "memory_placement_helpers.h"
 #include "temp_report.h"
+#include "scoped_env.h"
 
 namespace asval_test {
 namespace {
@@ -28,26 +29,7 @@ constexpr VkBufferUsageFlags kInputUsage = VK_BUFFER_USAGE_ACCELERATION_STRUCTUR
 constexpr uint32_t kNan = 0x7fc00000u;
 constexpr uint32_t kVertexOffset = 1024;  // where a test's vertices lie in its memory
 
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_) {
-      setenv(name_.c_str(), old_->c_str(), 1);
-    } else {
-      unsetenv(name_.c_str());
-    }
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
+using ScopedEnv = ScopedEnvironment;  // scoped_env.h
 
 bool KhronosLayerPresent() {
   uint32_t count = 0;

@@ -33,6 +33,7 @@
 #include "history_helpers.h"
 #include "record_checks_helpers.h"
 #include "temp_report.h"
+#include "scoped_env.h"
 
 extern char** environ;
 
@@ -625,27 +626,7 @@ TEST_CASE("protect valid twin: build, update, TLAS, compaction query, compaction
   CHECK(std::count(on.serialized.begin(), on.serialized.end(), 0) < static_cast<long>(on.serialized.size()));
 }
 
-// Sets an environment variable for the scope, restoring the value it had (the self-validation run sets some of these).
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnv() {
-    if (old_) {
-      setenv(name_.c_str(), old_->c_str(), 1);
-    } else {
-      unsetenv(name_.c_str());
-    }
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
+using ScopedEnv = ScopedEnvironment;  // scoped_env.h
 
 bool KhronosLayerPresent() {
   uint32_t count = 0;
