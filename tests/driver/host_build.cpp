@@ -102,16 +102,11 @@ void Rebase(DeviceBuild& build, VkDeviceAddress staging, VkAccelerationStructure
   if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
     auto& t = g.geometry.triangles;
     if (IndexSpan(t, range).bytes != 0) t.indexData.deviceAddress = Rebased(staging, build.copies[(*next_copy)++]);
-    if (range.primitiveCount != 0) {
-      // firstVertex is folded into the vertex address: the specification adds it once (to each index, or to the
-      // non-indexed vertex number), and lavapipe 25 adds it twice (to the base address as well), so the driver
-      // below is given 0.
-      t.vertexData.deviceAddress = Rebased(staging, build.copies[(*next_copy)++]) + range.firstVertex * t.vertexStride;
-      range.firstVertex = 0;
-    }
+    if (range.primitiveCount != 0) t.vertexData.deviceAddress = Rebased(staging, build.copies[(*next_copy)++]);
     if (t.transformData.hostAddress != nullptr) {
       t.transformData.deviceAddress = Rebased(staging, build.copies[(*next_copy)++]);
     }
+    FoldFirstVertex(g, range);
   } else if (g.geometryType == VK_GEOMETRY_TYPE_AABBS_KHR) {
     if (range.primitiveCount != 0) g.geometry.aabbs.data.deviceAddress = Rebased(staging, build.copies[(*next_copy)++]);
   } else if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {

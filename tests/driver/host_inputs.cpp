@@ -103,4 +103,11 @@ HostSpan InstanceSpan(const VkAccelerationStructureGeometryInstancesDataKHR& ins
   return {range.primitiveOffset, each * range.primitiveCount};
 }
 
+void FoldFirstVertex(VkAccelerationStructureGeometryKHR& geometry, VkAccelerationStructureBuildRangeInfoKHR& range) {
+  if (geometry.geometryType != VK_GEOMETRY_TYPE_TRIANGLES_KHR) return;
+  auto& triangles = geometry.geometry.triangles;
+  triangles.vertexData.deviceAddress += uint64_t{range.firstVertex} * triangles.vertexStride;
+  range.firstVertex = 0;
+}
+
 }  // namespace asval_test_driver

@@ -44,4 +44,10 @@ HostSpan AabbSpan(const VkAccelerationStructureGeometryAabbsDataKHR& aabbs,
 HostSpan InstanceSpan(const VkAccelerationStructureGeometryInstancesDataKHR& instances,
                       const VkAccelerationStructureBuildRangeInfoKHR& range);
 
+// Moves a triangle geometry's firstVertex into its vertex address (range.firstVertex becomes 0), which reads the
+// same vertices by the specification's addressing. The driver below is always given 0: the specification adds
+// firstVertex once (to each index, or to the non-indexed vertex number), lavapipe 25 adds it twice (to the base
+// address as well). Other geometries are left as they are.
+void FoldFirstVertex(VkAccelerationStructureGeometryKHR& geometry, VkAccelerationStructureBuildRangeInfoKHR& range);
+
 }  // namespace asval_test_driver

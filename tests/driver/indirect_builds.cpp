@@ -6,6 +6,7 @@
 #include "device_buffers.h"
 #include "device_executor.h"
 #include "driver_dispatch.h"
+#include "host_inputs.h"
 
 namespace asval_test_driver {
 
@@ -75,15 +76,7 @@ VkResult IndirectBuilds::RecordSecondary(const Site& site,
       range_pointers.push_back(ranges[i].data());
     }
     for (size_t i = 0; i < infos.size(); ++i) {
-      for (size_t g = 0; g < geometries[i].size(); ++g) {
-        // firstVertex into the vertex address: lavapipe 25 adds it twice (docs/testing.md).
-        auto& triangles = geometries[i][g].geometry.triangles;
-        VkAccelerationStructureBuildRangeInfoKHR& range = ranges[i][g];
-        if (geometries[i][g].geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
-          triangles.vertexData.deviceAddress += uint64_t{range.firstVertex} * triangles.vertexStride;
-          range.firstVertex = 0;
-        }
-      }
+      for (size_t g = 0; g < geometries[i].size(); ++g) FoldFirstVertex(geometries[i][g], ranges[i][g]);
       infos[i].pGeometries = geometries[i].data();
       infos[i].ppGeometries = nullptr;
     }

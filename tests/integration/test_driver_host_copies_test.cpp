@@ -286,5 +286,31 @@ TEST_CASE(
   operation.join(device.handle(), operation.handle);  // the deferred clone runs before the structures go
 }
 
+TEST_CASE("06731 / 06732 / 06733 / 06734 valid twin on the test driver: host size and bottom-level-pointer "
+          "queries with stride 8 and aligned pData stay silent and execute",
+          "[integration][copies][test-driver][valid]") {
+  const OnTestDriver driver;
+  // The two query types of VK_KHR_ray_tracing_maintenance1 (lavapipe has it), with the feature enabled.
+  VkPhysicalDeviceRayTracingMaintenance1FeaturesKHR maintenance{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MAINTENANCE_1_FEATURES_KHR};
+  maintenance.rayTracingMaintenance1 = VK_TRUE;
+  vkkit::DeviceOptions options = OnTestDriver::HostCommands();
+  options.extensions.push_back(VK_KHR_RAY_TRACING_MAINTENANCE_1_EXTENSION_NAME);
+  options.features = &maintenance;
+  CheckFixture f(nullptr, options);
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+  alignas(16) VkDeviceSize values[2] = {};
+  const VkAccelerationStructureKHR twice[2] = {built.source, built.source};
+  CHECK(host.properties(device.handle(), 2, twice, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SIZE_KHR, sizeof(values),
+                        values, 8) == VK_SUCCESS);
+  CHECK(values[0] != 0);
+  CHECK(host.properties(device.handle(), 1, &built.source,
+                        VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_BOTTOM_LEVEL_POINTERS_KHR, 8, values, 8) ==
+        VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
 }  // namespace
 }  // namespace asval_test
