@@ -76,6 +76,7 @@ class Device {
   VkQueue queue(uint32_t i) const { return queues_.at(i); }
   uint32_t queue_count() const { return static_cast<uint32_t>(queues_.size()); }
   const VkPhysicalDeviceAccelerationStructurePropertiesKHR& as_properties() const { return as_props_; }
+  const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_props_; }
 
   // Host-visible, coherent, mapped; usage gets SHADER_DEVICE_ADDRESS added.
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);

@@ -6,8 +6,7 @@
 #include "build_sizes.h"
 #include "history_recorder.h"
 #include "host_instances.h"
-#include "structure_memory.h"
-#include "vk_enum_string.h"
+#include "host_memory.h"
 
 namespace asval {
 
@@ -45,41 +44,23 @@ std::string PlacePrefix(const DeviceState& state, const BuildCommand& cmd, const
 
 [[gnu::cold, gnu::noinline]] bool ReportStructureMemory(const CheckContext& ctx, const BuildCommand& cmd,
                                                         const StructurePlace& place, const char* rule,
-                                                        const StructureMemory& memory, const MemoryState& record,
+                                                        const StructureHostMemory& host_memory,
                                                         bool host_visible_rule) {
-  char properties[256];
-  string_VkMemoryPropertyFlags(record.property_flags, properties, sizeof(properties));
-  return ReportBuild(ctx, cmd, place.info, rule, [&](std::string&) { return PlaceLocation(cmd, place); },
-                     "{}VkAccelerationStructureKHR 0x{:x}, whose VkBuffer 0x{:x} is bound to VkDeviceMemory 0x{:x} "
-                     "{}.",
-                     PlacePrefix(ctx.state, cmd, place, memory.structure->handle),
-                     reinterpret_cast<uint64_t>(memory.structure->handle),
-                     reinterpret_cast<uint64_t>(memory.buffer->handle), reinterpret_cast<uint64_t>(record.handle),
-                     host_visible_rule
-                         ? fmt::format("of memory type {} ({}), which is not VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT",
-                                       record.type_index, properties)
-                         : std::string("allocated with multiple instances (a device group); a host build needs "
-                                       "memory of one instance"));
+  return ReportBuild(ctx, cmd, place.info, rule, [&](std::string&) { return PlaceLocation(cmd, place); }, "{}{}",
+                     PlacePrefix(ctx.state, cmd, place, host_memory.memory.structure->handle),
+                     DescribeHostMemoryProblem(host_memory, host_visible_rule));
 }
 
 bool ValidateStructureMemory(const CheckContext& ctx, const BuildCommand& cmd, VkAccelerationStructureKHR handle,
                              const StructurePlace& place, const StructureRole& role) {
-  const std::optional<StructureMemory> memory = MemoryOfStructure(ctx.state, handle);
-  if (!memory || !memory->bound()) {
-    CountUnknownState(ctx);  // not a live structure, or not bound: the handles family's rules
-    return false;
-  }
-  const std::optional<std::shared_ptr<const MemoryState>> record = ctx.state.memories.find(memory->buffer->memory);
-  if (!record || !*record) {
-    CountUnknownState(ctx);
-    return false;
-  }
+  const std::optional<StructureHostMemory> host_memory = HostMemoryOfStructure(ctx, handle);
+  if (!host_memory) return false;  // unknown: counted
   bool skip = false;
-  if (!((*record)->property_flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
-    skip |= ReportStructureMemory(ctx, cmd, place, role.host_visible_rule, *memory, **record, true);
+  if (!host_memory->host_visible()) {
+    skip |= ReportStructureMemory(ctx, cmd, place, role.host_visible_rule, *host_memory, true);
   }
-  if ((*record)->multi_instance) {
-    skip |= ReportStructureMemory(ctx, cmd, place, role.multi_instance_rule, *memory, **record, false);
+  if (host_memory->multi_instance()) {
+    skip |= ReportStructureMemory(ctx, cmd, place, role.multi_instance_rule, *host_memory, false);
   }
   return skip;
 }

@@ -120,7 +120,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice device, VkD
       *data, function, "accelerationStructureHostCommands-03582", deferredOperation,
       [&] { return HostCopyOps(*pInfo); },
       [&](const CheckContext& ctx) { return ValidateCopyInfo(ctx, function, VK_NULL_HANDLE, *pInfo); },
-      [](const CheckContext&) { return false; },
+      [&](const CheckContext& ctx) { return ValidateHostCopyStructures(ctx, *pInfo); },
       [&] { return data->dispatch.CopyAccelerationStructureKHR(device, deferredOperation, pInfo); });
 }
 
@@ -165,6 +165,9 @@ VKAPI_ATTR VkResult VKAPI_CALL WriteAccelerationStructuresPropertiesKHR(
     skip |= ValidateWriteProperties(ctx, function, VK_NULL_HANDLE, accelerationStructureCount, pAccelerationStructures,
                                     queryType, VK_NULL_HANDLE, 0);
     skip |= ValidateHostPropertyData(ctx, function, accelerationStructureCount, queryType, dataSize, pData, stride);
+  }
+  if (ctx.Enabled(kCheckHost)) {
+    skip |= ValidateHostPropertyStructures(ctx, accelerationStructureCount, pAccelerationStructures);
   }
   if (data->state.history_tracked) {
     skip |= ValidateHostOps(ctx, HostWritePropertiesOps(accelerationStructureCount, pAccelerationStructures, queryType),

@@ -22,6 +22,8 @@ struct InstanceData {
   PFN_vkGetPhysicalDeviceFeatures2 GetPhysicalDeviceFeatures2 = nullptr;
   PFN_vkGetPhysicalDeviceFeatures2KHR GetPhysicalDeviceFeatures2KHR = nullptr;
   PFN_vkGetPhysicalDeviceMemoryProperties GetPhysicalDeviceMemoryProperties = nullptr;
+  PFN_vkGetPhysicalDeviceMemoryProperties2 GetPhysicalDeviceMemoryProperties2 = nullptr;
+  PFN_vkGetPhysicalDeviceMemoryProperties2KHR GetPhysicalDeviceMemoryProperties2KHR = nullptr;
   PFN_vkCreateDevice CreateDevice = nullptr;
 };
 
@@ -39,7 +41,8 @@ struct DeviceFunctions {
   X(GetAccelerationStructureDeviceAddressKHR) X(CmdCopyAccelerationStructureKHR)                          \
   X(CmdCopyAccelerationStructureToMemoryKHR) X(CmdCopyMemoryToAccelerationStructureKHR)                   \
   X(CmdWriteAccelerationStructuresPropertiesKHR) X(DestroyDeferredOperationKHR)                          \
-  X(ResetCommandBuffer) X(CmdExecuteCommands) X(CmdCopyBuffer) X(BindBufferMemory2)
+  X(ResetCommandBuffer) X(CmdExecuteCommands) X(CmdCopyBuffer) X(BindBufferMemory2)                  \
+  X(GetBufferMemoryRequirements2) X(GetDeviceBufferMemoryRequirements)
 // clang-format on
 #define ASVAL_DRIVER_DECLARE(name) PFN_vk##name name = nullptr;
   ASVAL_DRIVER_DEVICE_FUNCTIONS(ASVAL_DRIVER_DECLARE)
@@ -50,7 +53,7 @@ struct DeviceData {
   VkDevice device = VK_NULL_HANDLE;
   PFN_vkGetDeviceProcAddr next_gdpa = nullptr;
   DeviceFunctions vk;
-  VkPhysicalDeviceMemoryProperties memory{};
+  VkPhysicalDeviceMemoryProperties memory{};  // the driver below's (without the added type: memory_types.h)
   uint32_t queue_family = 0;
   // The application's queues are the driver's: the test driver's own submissions take this lock, and so do the
   // application's (vkQueueSubmit and the waits go through the test driver), as a queue is externally synchronized.

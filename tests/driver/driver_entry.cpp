@@ -11,6 +11,7 @@
 #include "driver_dispatch.h"
 #include "host_commands.h"
 #include "indirect_builds.h"
+#include "memory_types.h"
 
 #define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
 
@@ -39,6 +40,21 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2KHR(VkPhysicalDevice gpu, V
   (instance->GetPhysicalDeviceFeatures2KHR ? instance->GetPhysicalDeviceFeatures2KHR
                                            : instance->GetPhysicalDeviceFeatures2)(gpu, features);
   AddFeatures(features->pNext);
+}
+
+// The memory the layers above see: below's types and the added device-local one (memory_types.h).
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceMemoryProperties(VkPhysicalDevice gpu,
+                                                             VkPhysicalDeviceMemoryProperties* properties) {
+  InstanceOf(gpu)->GetPhysicalDeviceMemoryProperties(gpu, properties);
+  AddMemoryType(properties);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceMemoryProperties2(VkPhysicalDevice gpu,
+                                                              VkPhysicalDeviceMemoryProperties2* properties) {
+  InstanceData* instance = InstanceOf(gpu);
+  (instance->GetPhysicalDeviceMemoryProperties2 ? instance->GetPhysicalDeviceMemoryProperties2
+                                                : instance->GetPhysicalDeviceMemoryProperties2KHR)(gpu, properties);
+  AddMemoryType(&properties->memoryProperties);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL EnumeratePhysicalDevices(VkInstance handle, uint32_t* count, VkPhysicalDevice* gpus) {
@@ -71,6 +87,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* info, 
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceFeatures2);
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceFeatures2KHR);
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties2);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties2KHR);
   ASVAL_DRIVER_LOAD(CreateDevice);
 #undef ASVAL_DRIVER_LOAD
   return VK_SUCCESS;
@@ -213,6 +231,38 @@ VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice handle, VkBuffer buffer, const
   device->vk.DestroyBuffer(handle, buffer, allocator);
 }
 
+VKAPI_ATTR VkResult VKAPI_CALL AllocateMemory(VkDevice handle, const VkMemoryAllocateInfo* info,
+                                              const VkAllocationCallbacks* allocator, VkDeviceMemory* memory) {
+  DeviceData* device = FindDevice(handle);
+  VkMemoryAllocateInfo below = *info;
+  below.memoryTypeIndex = MemoryTypeBelow(device->memory, info->memoryTypeIndex);
+  return device->vk.AllocateMemory(handle, &below, allocator, memory);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetBufferMemoryRequirements(VkDevice handle, VkBuffer buffer,
+                                                       VkMemoryRequirements* requirements) {
+  DeviceData* device = FindDevice(handle);
+  device->vk.GetBufferMemoryRequirements(handle, buffer, requirements);
+  requirements->memoryTypeBits = MemoryTypeBitsAbove(device->memory, requirements->memoryTypeBits);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetBufferMemoryRequirements2(VkDevice handle, const VkBufferMemoryRequirementsInfo2* info,
+                                                        VkMemoryRequirements2* requirements) {
+  DeviceData* device = FindDevice(handle);
+  device->vk.GetBufferMemoryRequirements2(handle, info, requirements);
+  VkMemoryRequirements& r = requirements->memoryRequirements;
+  r.memoryTypeBits = MemoryTypeBitsAbove(device->memory, r.memoryTypeBits);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetDeviceBufferMemoryRequirements(VkDevice handle,
+                                                             const VkDeviceBufferMemoryRequirements* info,
+                                                             VkMemoryRequirements2* requirements) {
+  DeviceData* device = FindDevice(handle);
+  device->vk.GetDeviceBufferMemoryRequirements(handle, info, requirements);
+  VkMemoryRequirements& r = requirements->memoryRequirements;
+  r.memoryTypeBits = MemoryTypeBitsAbove(device->memory, r.memoryTypeBits);
+}
+
 void BufferBound(DeviceData* device, VkBuffer buffer) {
   if (!device->buffers->HasAddress(buffer)) return;
   VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
@@ -333,6 +383,16 @@ PFN_vkVoidFunction DeviceFunction(const char* name) {
   ASVAL_DRIVER_HOOK(DestroyBuffer)
   ASVAL_DRIVER_HOOK(BindBufferMemory)
   ASVAL_DRIVER_HOOK(BindBufferMemory2)
+  ASVAL_DRIVER_HOOK(AllocateMemory)
+  ASVAL_DRIVER_HOOK(GetBufferMemoryRequirements)
+  ASVAL_DRIVER_HOOK(GetBufferMemoryRequirements2)
+  ASVAL_DRIVER_HOOK(GetDeviceBufferMemoryRequirements)
+  if (std::strcmp(name, "vkGetBufferMemoryRequirements2KHR") == 0) {
+    return reinterpret_cast<PFN_vkVoidFunction>(&GetBufferMemoryRequirements2);
+  }
+  if (std::strcmp(name, "vkGetDeviceBufferMemoryRequirementsKHR") == 0) {
+    return reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceBufferMemoryRequirements);
+  }
   if (std::strcmp(name, "vkBindBufferMemory2KHR") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&BindBufferMemory2);
   if (std::strcmp(name, "vkQueueSubmit2KHR") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&QueueSubmit2);
   return nullptr;
@@ -344,6 +404,11 @@ PFN_vkVoidFunction InstanceFunction(const char* name) {
   ASVAL_DRIVER_HOOK(EnumeratePhysicalDevices)
   ASVAL_DRIVER_HOOK(GetPhysicalDeviceFeatures2)
   ASVAL_DRIVER_HOOK(GetPhysicalDeviceFeatures2KHR)
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceMemoryProperties)
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceMemoryProperties2)
+  if (std::strcmp(name, "vkGetPhysicalDeviceMemoryProperties2KHR") == 0) {
+    return reinterpret_cast<PFN_vkVoidFunction>(&GetPhysicalDeviceMemoryProperties2);
+  }
   ASVAL_DRIVER_HOOK(CreateDevice)
 #undef ASVAL_DRIVER_HOOK
   return nullptr;

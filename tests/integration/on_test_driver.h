@@ -26,4 +26,22 @@ class OnTestDriver {
   ScopedEnvironment layers_;
 };
 
+// A structure on a buffer bound to device-local memory that is not host-visible (the test driver's added memory
+// type: tests/driver/memory_types.h), where a discrete GPU keeps its structures; destroyed with the scope.
+class DeviceLocalStructure {
+ public:
+  DeviceLocalStructure(vkkit::Device& device, VkAccelerationStructureTypeKHR type, VkDeviceSize size);
+  ~DeviceLocalStructure();
+  DeviceLocalStructure(const DeviceLocalStructure&) = delete;
+  DeviceLocalStructure& operator=(const DeviceLocalStructure&) = delete;
+
+  VkAccelerationStructureKHR handle() const { return structure_; }
+
+ private:
+  vkkit::Device& device_;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkAccelerationStructureKHR structure_ = VK_NULL_HANDLE;
+};
+
 }  // namespace asval_test

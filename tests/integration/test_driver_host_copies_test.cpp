@@ -217,6 +217,63 @@ TEST_CASE(
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE(
+    "buffer-03727 / 03728 / 03730 / 03731 / 03733: host copies and property writes of structures on memory that "
+    "is not host-visible are reported",
+    "[integration][host][test-driver][03727][03728][03730][03731][03733]") {
+  const OnTestDriver driver;
+  CheckFixture f("host", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  HostCommands host(device.handle());
+  HostBuilt built(device);
+  const DeviceLocalStructure device_local(device, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 1 << 16);
+  alignas(16) unsigned char bytes[1 << 12] = {};
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = built.source;
+  copy.dst = built.clone;
+  copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR;
+  SECTION("03727: the source of a copy") {
+    copy.src = device_local.handle();
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureKHR-buffer-03727");
+    host.copy(device.handle(), VK_NULL_HANDLE, &copy);
+  }
+  SECTION("03728: the destination of a copy") {
+    copy.dst = device_local.handle();
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureKHR-buffer-03728");
+    host.copy(device.handle(), VK_NULL_HANDLE, &copy);
+  }
+  SECTION("03731: the structure serialized") {
+    VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+    to.src = device_local.handle();
+    to.dst.hostAddress = bytes;
+    to.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyAccelerationStructureToMemoryKHR-buffer-03731");
+    host.to_memory(device.handle(), VK_NULL_HANDLE, &to);
+  }
+  SECTION("03730: the structure deserialized into") {
+    VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+    from.src.hostAddress = bytes;
+    from.dst = device_local.handle();
+    from.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_DESERIALIZE_KHR;
+    f.monitor().Expect("VUID-vkCopyMemoryToAccelerationStructureKHR-buffer-03730");
+    host.from_memory(device.handle(), VK_NULL_HANDLE, &from);
+  }
+  SECTION("03733: one report for the structures queried, at the first on such memory") {
+    const VkAccelerationStructureKHR queried[3] = {built.source, device_local.handle(), device_local.handle()};
+    alignas(16) VkDeviceSize sizes[3] = {};
+    f.monitor().Expect("VUID-vkWriteAccelerationStructuresPropertiesKHR-buffer-03733");
+    host.properties(device.handle(), 3, queried, kSerializationSize, sizeof(sizes), sizes, 8);
+    const std::vector<Message> messages = f.monitor().Take();
+    REQUIRE(messages.size() == 1);
+    CHECK(messages[0].id_name == "VUID-vkWriteAccelerationStructuresPropertiesKHR-buffer-03733");
+    CHECK(messages[0].text.find("pAccelerationStructures[1]") != std::string::npos);
+    CHECK(messages[0].text.find("1 later elements of pAccelerationStructures") != std::string::npos);
+    CHECK(messages[0].text.find("not VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT") != std::string::npos);
+    return;
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
 // A deferred operation of the device's, destroyed with the scope.
 struct DeferredOperation {
   explicit DeferredOperation(VkDevice device)

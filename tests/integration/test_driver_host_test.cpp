@@ -49,5 +49,37 @@ TEST_CASE("03581 on the test driver: a host build on a device that did not enabl
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE(
+    "pInfos-03722 / 03723 / 03724 on the test driver: host builds of, from or over structures on memory that is "
+    "not host-visible are reported",
+    "[integration][host][test-driver][03722][03723][03724]") {
+  const OnTestDriver driver;
+  CheckFixture f("host", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  Scene scene(device);
+  const DeviceLocalStructure device_local(device, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, 1 << 16);
+  SECTION("03722: the destination") {
+    HostBuild build(scene, scene.Triangles());
+    build.info.dstAccelerationStructure = device_local.handle();
+    f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-pInfos-03722");
+    build.Call(device);
+  }
+  SECTION("03723: an update's source") {
+    HostBuild build(scene, scene.Triangles());
+    build.info.flags |= VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR;
+    build.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
+    build.info.srcAccelerationStructure = device_local.handle();
+    f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-pInfos-03723");
+    build.Call(device);
+  }
+  SECTION("03724: a structure an instance references") {
+    HostBuild build(scene, scene.Instances());
+    build.instance.accelerationStructureReference = reinterpret_cast<uint64_t>(device_local.handle());
+    f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-pInfos-03724");
+    build.Call(device);
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
 }  // namespace
 }  // namespace asval_test

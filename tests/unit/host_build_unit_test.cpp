@@ -8,6 +8,7 @@
 
 #include "build_state_fixture.h"
 #include "history_recorder.h"
+#include "host_copy_rules.h"
 #include "host_mappings.h"
 
 namespace asval {
@@ -308,6 +309,61 @@ TEST_CASE("deferredOperation-03678: a deferred operation still running an earlie
   CompleteDeferredOps(f.state, operation, VK_SUCCESS);
   f.Validate(second);
   CHECK(f.Take().empty());
+}
+
+// The host copies and property writes share the host build's judge of a structure's memory (host_memory.h); here
+// what the test driver cannot give through the loader: memory of several instances (a device group).
+TEST_CASE("buffer-03780 / 03781 / 03782 / 03783 / 03784: host copies and property writes on memory allocated "
+          "with multiple instances",
+          "[host][03780][03781][03782][03783][03784]") {
+  BuildStateFixture f;
+  const CheckContext ctx{f.state, f.reporter, kCheckHost};
+  const VkBuffer single = f.Buffer(1 << 20, kAsStorage, f.Memory(1 << 20));
+  const VkBuffer shared = f.Buffer(1 << 20, kAsStorage, f.Memory(1 << 20, 0, 0b11));
+  const VkAccelerationStructureKHR good = f.Structure(single, 0, 4096, kBottom);
+  const VkAccelerationStructureKHR bad = f.Structure(shared, 0, 4096, kBottom);
+  alignas(16) unsigned char bytes[64] = {};
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = good;
+  copy.dst = good;
+  CHECK_FALSE(ValidateHostCopyStructures(ctx, copy));  // the valid twin: one instance, host-visible
+  CHECK(f.Take().empty());
+  copy.src = bad;
+  ValidateHostCopyStructures(ctx, copy);
+  CHECK(f.Take() == std::vector<std::string>{"VUID-vkCopyAccelerationStructureKHR-buffer-03780"});
+  copy.src = good;
+  copy.dst = bad;
+  ValidateHostCopyStructures(ctx, copy);
+  CHECK(f.Take() == std::vector<std::string>{"VUID-vkCopyAccelerationStructureKHR-buffer-03781"});
+  VkCopyMemoryToAccelerationStructureInfoKHR from{VK_STRUCTURE_TYPE_COPY_MEMORY_TO_ACCELERATION_STRUCTURE_INFO_KHR};
+  from.src.hostAddress = bytes;
+  from.dst = bad;
+  ValidateHostCopyMemoryTo(ctx, from);
+  CHECK(f.Take() == std::vector<std::string>{"VUID-vkCopyMemoryToAccelerationStructureKHR-buffer-03782"});
+  VkCopyAccelerationStructureToMemoryInfoKHR to{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+  to.src = bad;
+  to.dst.hostAddress = bytes;
+  ValidateHostCopyToMemory(ctx, to);
+  CHECK(f.Take() == std::vector<std::string>{"VUID-vkCopyAccelerationStructureToMemoryKHR-buffer-03783"});
+  const VkAccelerationStructureKHR queried[3] = {good, bad, bad};
+  ValidateHostPropertyStructures(ctx, 3, queried);
+  CHECK(f.Take() == std::vector<std::string>{"VUID-vkWriteAccelerationStructuresPropertiesKHR-buffer-03784"});
+  CHECK_FALSE(ValidateHostPropertyStructures(ctx, 1, &good));
+  CHECK(f.Take().empty());
+}
+
+TEST_CASE("host copies unit: structures the layer does not know are skipped and counted, never reported", "[host]") {
+  BuildStateFixture f;
+  const CheckContext ctx{f.state, f.reporter, kCheckHost};
+  const auto unknown = reinterpret_cast<VkAccelerationStructureKHR>(uintptr_t{0xdead0});
+  const uint64_t before = f.state.checks_skipped_unknown_state.load();
+  VkCopyAccelerationStructureInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR};
+  copy.src = unknown;
+  copy.dst = unknown;
+  CHECK_FALSE(ValidateHostCopyStructures(ctx, copy));
+  CHECK_FALSE(ValidateHostPropertyStructures(ctx, 1, &unknown));
+  CHECK(f.Take().empty());
+  CHECK(f.state.checks_skipped_unknown_state.load() == before + 3);
 }
 
 }  // namespace
