@@ -322,8 +322,21 @@ def validate(registry, family_names, newest, older, sources):
     return errors
 
 
+def renamed_rules(newest):
+    """Older names that the chapter's pages still print beside their newest numbers (the manual pages are older
+    than the chapter): old VUID -> the newest VUIDs of the same rule. Such a rule is counted once, under its newest
+    number; messages use the newest number and mute filters match the old one (scripts/vuids_newer.json)."""
+    renamed = {}
+    for new, olds in load_json("scripts/vuids_newer.json")["aliases"].items():
+        for old in olds:
+            if old in newest and new in newest:
+                renamed.setdefault(old, []).append(new)
+    return renamed
+
+
 def render(registry, family_names, newest):
-    in_scope = sorted(v for v in newest if any(v.startswith(p) for p in registry["scope"]))
+    renamed = renamed_rules(newest)
+    in_scope = sorted(v for v in newest if any(v.startswith(p) for p in registry["scope"]) and v not in renamed)
     entries = {e["vuid"]: e for e in registry["checks"]}
     lines = [
         "# Coverage: which Valid Usage rules asval checks",
@@ -334,7 +347,8 @@ def render(registry, family_names, newest):
         "*left to the Khronos layer* marks the implicit rules (valid handles, enums and pointers, structure types,",
         "array lengths, the command buffer's state) that the Khronos validation layer checks and asval does not",
         "repeat.",
-        "A family can be switched off with the `enabled_checks` setting.",
+        "A family can be switched off with the `enabled_checks` setting. Rules that the specification renumbered",
+        "are counted once, under their newest number (the older names are listed at the end).",
         "",
         "## Summary",
         "",
@@ -368,6 +382,12 @@ def render(registry, family_names, newest):
         if entry.get("note"):
             details = (details + ". " if details else "") + entry["note"]
         lines.append(f"| `{vuid}` | {entry['family']} | {STATUSES[entry['status']]} | {details} |")
+    in_scope_renamed = sorted(v for v in renamed if any(v.startswith(p) for p in registry["scope"]))
+    if in_scope_renamed:
+        lines += ["", "## Older names", "", "Printed by the older manual pages; the rule is the newer VUID's.", "",
+                  "| older VUID | now |", "|---|---|"]
+        for old in in_scope_renamed:
+            lines.append(f"| `{old}` | {', '.join(f'`{new}`' for new in sorted(renamed[old]))} |")
     return "\n".join(lines) + "\n"
 
 

@@ -967,13 +967,20 @@ ALIAS_SIMILARITY = 0.65
 # Renumberings the similarity test cannot find on its own, checked by reading both texts:
 # the newer scratch-usage rules 12260/12261 merged "must be a valid VkDeviceAddress" (03802) and "STORAGE_BUFFER
 # usage" (03674) and split them by build mode.
+# The older indirect page's "if <address> is the address of a non-sparse buffer then it must be bound completely
+# and contiguously to a single VkDeviceMemory object" (03645, 03803, 03805, 03807, 03809, 03812, 03814) is gone from
+# the chapter: a valid VkDeviceAddress is one of a bound buffer (a non-sparse buffer is bound whole, to one memory),
+# so each is now part of its address's "must be a valid VkDeviceAddress" (or "in the range of one buffer") rule.
+_INDIRECT = 'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-'
 MANUAL_ALIASES = {
-    'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-12260': [
-        'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03674',
-        'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03802'],
-    'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-12261': [
-        'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03674',
-        'VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03802'],
+    _INDIRECT + 'pInfos-12260': [_INDIRECT + 'pInfos-03674', _INDIRECT + 'pInfos-03802', _INDIRECT + 'pInfos-03803'],
+    _INDIRECT + 'pInfos-12261': [_INDIRECT + 'pInfos-03674', _INDIRECT + 'pInfos-03802', _INDIRECT + 'pInfos-03803'],
+    _INDIRECT + 'pIndirectDeviceAddresses-03646': [_INDIRECT + 'pIndirectDeviceAddresses-03645'],
+    _INDIRECT + 'pInfos-03804': [_INDIRECT + 'pInfos-03805'],
+    _INDIRECT + 'pInfos-03806': [_INDIRECT + 'pInfos-03807'],
+    _INDIRECT + 'pInfos-03808': [_INDIRECT + 'pInfos-03809'],
+    _INDIRECT + 'pInfos-03811': [_INDIRECT + 'pInfos-03812'],
+    _INDIRECT + 'pInfos-03813': [_INDIRECT + 'pInfos-03814'],
 }
 
 
@@ -1027,6 +1034,11 @@ def find_aliases(registry, pages, newer_vuids):
         if matches:
             aliases[newest] = sorted(matches)
         review.append((newest, sorted(matches), scored[:3]))
+    # Manual renumberings onto rules the registry already has (a rule that absorbed one the chapter dropped).
+    for newest, olders in sorted(MANUAL_ALIASES.items()):
+        if newest not in candidates:
+            aliases[newest] = sorted(set(olders))
+            review.append((newest, sorted(set(olders)), []))
     return aliases, review
 
 
