@@ -150,9 +150,11 @@ Device::~Device() {
   vkDestroyDevice(device_, nullptr);
 }
 
-uint32_t Device::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const {
+uint32_t Device::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags,
+                                VkMemoryPropertyFlags excluded) const {
   for (uint32_t i = 0; i < memory_props_.memoryTypeCount; ++i) {
-    if ((type_bits & (1u << i)) && (memory_props_.memoryTypes[i].propertyFlags & flags) == flags) return i;
+    const VkMemoryPropertyFlags has = memory_props_.memoryTypes[i].propertyFlags;
+    if ((type_bits & (1u << i)) && (has & flags) == flags && !(has & excluded)) return i;
   }
   throw std::runtime_error("no suitable memory type");
 }

@@ -76,7 +76,6 @@ class Device {
   VkQueue queue(uint32_t i) const { return queues_.at(i); }
   uint32_t queue_count() const { return static_cast<uint32_t>(queues_.size()); }
   const VkPhysicalDeviceAccelerationStructurePropertiesKHR& as_properties() const { return as_props_; }
-  const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_props_; }
 
   // Host-visible, coherent, mapped; usage gets SHADER_DEVICE_ADDRESS added.
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
@@ -95,8 +94,8 @@ class Device {
   PFN_vkGetAccelerationStructureDeviceAddressKHR GetAccelerationStructureDeviceAddressKHR = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT SetDebugUtilsObjectNameEXT = nullptr;
 
- // The first memory type in type_bits with all of flags; throws if none.
-  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+ // The first memory type in type_bits with all of flags and none of excluded; throws if none.
+  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags flags, VkMemoryPropertyFlags excluded = 0) const;
 
  private:
 

@@ -1,7 +1,5 @@
 #include "on_test_driver.h"
 
-#include <stdexcept>
-
 namespace asval_test {
 
 std::string LayersWithTestDriver() {
@@ -19,16 +17,9 @@ DeviceLocalStructure::DeviceLocalStructure(vkkit::Device& device, VkAcceleration
   vkkit::Check(vkCreateBuffer(device.handle(), &info, nullptr, &buffer_), "vkCreateBuffer");
   VkMemoryRequirements needs{};
   vkGetBufferMemoryRequirements(device.handle(), buffer_, &needs);
-  const VkPhysicalDeviceMemoryProperties& memory = device.memory_properties();
-  uint32_t type_index = UINT32_MAX;
-  for (uint32_t i = 0; i < memory.memoryTypeCount && type_index == UINT32_MAX; ++i) {
-    const VkMemoryPropertyFlags flags = memory.memoryTypes[i].propertyFlags;
-    if ((needs.memoryTypeBits & (1u << i)) && (flags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT) &&
-        !(flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
-      type_index = i;
-    }
-  }
-  if (type_index == UINT32_MAX) throw std::runtime_error("no device-local memory type that is not host-visible");
+  // Throws when the driver has no such type (not the test driver).
+  const uint32_t type_index = device.FindMemoryType(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                                                    VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &flags};
