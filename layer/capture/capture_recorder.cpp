@@ -100,6 +100,21 @@ void ResolveDestinations(const DeviceState& state, uint32_t info_count,
   }
 }
 
+// The destinations of an indirect build command of several infos: their addresses (None-03407); the bytes each
+// build writes depend on the primitive counts on the device, so their spans stay unknown (03706 skipped, counted).
+void ResolveIndirectDestinations(const DeviceState& state, uint32_t info_count,
+                                 const VkAccelerationStructureBuildGeometryInfoKHR* infos,
+                                 std::vector<CommandDestination>& out) {
+  out.assign(info_count, CommandDestination{});
+  for (uint32_t i = 0; i < info_count; ++i) {
+    out[i].handle = infos[i].dstAccelerationStructure;
+    out[i].element = i;
+    if (const std::optional<StructureMemory> memory = MemoryOfStructure(state, out[i].handle)) {
+      out[i].address = memory->structure->device_address;
+    }
+  }
+}
+
 // What the range rules need of an indirect build's geometry j (pIndirectDeviceAddresses-03651): its range is read
 // by the device, so it is judged at completion against the geometry as the app recorded it, copied now (the app's
 // structures need not outlive the call).
@@ -115,6 +130,86 @@ void KeepRangeFacts(const VkAccelerationStructureBuildGeometryInfoKHR& info, uin
     out->max_vertex = t.maxVertex;
   }
   out->range_facts = true;
+}
+
+// Room in the run's open job block for `jobs` more jobs of the layer's dispatch: the block kept when it has room,
+// else a new one, larger each time a run outgrows one (a long run takes few dispatches). False when the pipeline
+// or the log's memory is missing (the captures are then copied, or not made).
+bool RoomForJobs(const CaptureContext& ctx, CaptureRun& run, CaptureLog& log, uint32_t jobs) {
+  JobBlock& block = run.block;
+  const VkPipeline pipeline = ctx.pool.ReducePipeline();
+  if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
+    ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
+  }
+  if (block.Room() >= jobs && block.dispatch.pipeline == pipeline) return true;
+  if (block.dispatch.jobs != 0) run.dispatches.push_back(block.dispatch);
+  return AcquireJobs(block, log, jobs, std::max<uint32_t>(64, 2 * block.capacity), pipeline);
+}
+
+// The second stage of an indirect build's capture (issue 28): info i's geometries read by the layer's dispatch
+// where the build read them, at the offsets and for the count of the range infos the device reads (known on the
+// device alone: the dispatch reads each range info first, reduce_inputs.comp), into results sized for the
+// ppMaxPrimitiveCounts[i] the build may read at most. Only where the pool dispatches for arrays of instance pointers
+// too (CaptureGathers: no copy recorded beforehand can name these bytes); reduced whatever capture_method says.
+// False, with *why, when a geometry cannot be read so (the info's activity and instances are then unknown).
+// *bytes: what the results cost the recording's budget.
+bool ReduceIndirectGeometries(const CaptureContext& ctx, CaptureRun& run, CaptureLog& log,
+                              const VkAccelerationStructureBuildGeometryInfoKHR& info, VkDeviceAddress ranges,
+                              uint32_t stride, const uint32_t* max_counts, std::vector<CapturedGeometry>& planned,
+                              VkDeviceSize* bytes, CaptureSkip* why) {
+  *why = CaptureSkip::kGeometryNotCaptured;
+  if (!ctx.pool.gathers() || (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0) return false;
+  // Kept from call to call on this thread (nothing here calls back into the app): no allocation per call.
+  thread_local std::vector<CaptureSource> sources;
+  const uint32_t n = info.geometryCount;
+  VkDeviceSize total = 0;
+  for (uint32_t j = 0; j < n; ++j) {
+    const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+    // Planned as a range of offset 0 and the most primitives: the dispatch applies the range info's own.
+    VkAccelerationStructureBuildRangeInfoKHR most{};
+    most.primitiveCount = max_counts[j];
+    sources.clear();
+    CapturedGeometry& p = planned[j];
+    if (!g || !PlanCapturedGeometry(*g, most, false, &p, sources, why)) return false;
+    KeepRangeFacts(info, j, &p);
+    if (most.primitiveCount == 0) continue;
+    const bool gathered = Gatherable(p) && sources.size() == 1;
+    if (!gathered && !Reducible(p)) return false;
+    const CaptureSource* const first = sources.data();
+    const CaptureSource* const last = first + sources.size();
+    total = SaturatingAddBytes(total, gathered ? GatheredCost(p) : ReducedCost(p, SourcesOf(p, first, last)));
+  }
+  if (SaturatingAddBytes(log.bytes_captured, total) > ctx.budget_bytes) {
+    *why = CaptureSkip::kOverBudget;
+    return false;
+  }
+  if (!RoomForJobs(ctx, run, log, std::min(n, kReduceMaxJobsPerDispatch + 1))) {
+    *why = CaptureSkip::kCaptureMemoryFailed;
+    return false;
+  }
+  const uint32_t first_job = run.block.dispatch.jobs;
+  for (uint32_t j = 0; j < n; ++j) {
+    if (max_counts[j] == 0) continue;
+    const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
+    VkAccelerationStructureBuildRangeInfoKHR most{};
+    most.primitiveCount = max_counts[j];
+    sources.clear();
+    CapturedGeometry& p = planned[j];
+    PlanCapturedGeometry(*g, most, false, &p, sources, why);  // as above: the sources again
+    KeepRangeFacts(info, j, &p);
+    const VkDeviceAddress range = ranges + VkDeviceSize{stride} * j;
+    const CaptureSource* const first = sources.data();
+    const CaptureSource* const last = first + sources.size();
+    const bool ok = Gatherable(p) && sources.size() == 1
+                        ? GatherInstancePointers(ctx.state, log, p, sources[0], run.block, why, range)
+                        : ReduceGeometry(ctx.state, log, p, SourcesOf(p, first, last), run.block, why, range);
+    if (!ok) {
+      run.block.dispatch.jobs = first_job;
+      return false;
+    }
+  }
+  *bytes = total;
+  return true;
 }
 
 }  // namespace
@@ -137,6 +232,9 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
     // No geometry data (only the range infos are captured): the facts their rules need. Kept from call to call on
     // this thread (nothing here calls back into the app): no allocation per call.
     thread_local std::vector<CapturedGeometry> planned;
+    thread_local std::vector<CommandDestination> destinations;
+    bool destinations_logged = false;
+    uint32_t first_destination = 0;
     CaptureRun& run = recording.capture_run;
     const std::size_t copies_before = run.copies.size();
     CommandCounts counts;
@@ -147,6 +245,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
       CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
       CapturedInfo entry;
       entry.indirect = true;
+      entry.element = i;
       entry.geometry_count = n;
       entry.indirect_stride = strides[i];
       const VkDeviceSize bytes =
@@ -169,7 +268,30 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
       }
       planned.assign(n, CapturedGeometry{});
       for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
-      captured[i] = log.AddInfo(entry, planned.data(), max_primitive_counts[i], bytes);
+      VkDeviceSize geometry_bytes = 0;
+      if (reserved && NeedsCapture(ctx.mode, infos[i]) && (infos[i].pGeometries || infos[i].ppGeometries)) {
+        CaptureSkip geometry_why = CaptureSkip::kGeometryNotCaptured;
+        entry.indirect_geometry = ReduceIndirectGeometries(ctx, run, log, infos[i], addresses[i], strides[i],
+                                                           max_primitive_counts[i], planned, &geometry_bytes,
+                                                           &geometry_why);
+        if (!entry.indirect_geometry) {
+          counts.NotCaptured(geometry_why);
+          planned.assign(n, CapturedGeometry{});
+          for (uint32_t j = 0; j < n; ++j) KeepRangeFacts(infos[i], j, &planned[j]);
+          geometry_bytes = 0;
+        } else if (info_count > 1 && infos[i].type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
+          if (!destinations_logged) {  // once per command, shared by its top-level infos
+            ResolveIndirectDestinations(ctx.state, info_count, infos, destinations);
+            first_destination = log.AddDestinations(destinations.data(), info_count);
+            destinations_logged = true;
+          }
+          entry.first_destination = first_destination;
+          entry.destination_count = info_count;
+        }
+        counts.bytes += geometry_bytes;
+      }
+      captured[i] =
+          log.AddInfo(entry, planned.data(), max_primitive_counts[i], SaturatingAddBytes(bytes, geometry_bytes));
     }
     KeepOpen(ctx, run, copies_before);
     counts.AddTo(ctx.counters);
@@ -249,15 +371,7 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, CommandBufferState& re
           if (NeedsCapture(ctx.mode, infos[k])) jobs += std::min(infos[k].geometryCount, kReduceMaxJobsPerDispatch + 1);
           jobs = std::min(jobs, kReduceMaxJobsPerDispatch + 1);
         }
-        const VkPipeline pipeline = ctx.pool.ReducePipeline();
-        if (pipeline == VK_NULL_HANDLE && !ctx.counters.failures.reduce_pipeline_failed.exchange(true)) {
-          ctx.counters.failures.inserted_failures.fetch_add(1, std::memory_order_relaxed);  // once: made once
-        }
-        use_block = block.Room() >= jobs && block.dispatch.pipeline == pipeline;
-        if (!use_block) {  // a new block, larger each time a run outgrows one: a long run takes few dispatches
-          if (block.dispatch.jobs != 0) run.dispatches.push_back(block.dispatch);
-          use_block = AcquireJobs(block, log, jobs, std::max<uint32_t>(64, 2 * block.capacity), pipeline);
-        }
+        use_block = RoomForJobs(ctx, run, log, jobs);
         block_tried = true;
       }
     }

@@ -23,11 +23,11 @@ ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDevic
     const VertexFormatInfo& format = VertexFormatFacts(g.vertex_format);
     job.kind = ReduceJob::kTriangles;
     job.stride = static_cast<uint32_t>(g.vertex_stride);
-    job.x_kind = !format.hasNaN                              ? ReduceJob::kNoNaN
-                 : format.kind == ComponentKind::Float16 ? ReduceJob::kFloat16
-                                                         : ReduceJob::kFloat32;
-    job.components = std::min<uint32_t>(format.componentCount, 3);
-    job.index_bytes = static_cast<uint32_t>(std::max(builder::IndexTypeBytes(g.index_type), 0));
+    const ReduceJob::XKind x_kind = !format.hasNaN                              ? ReduceJob::kNoNaN
+                                    : format.kind == ComponentKind::Float16 ? ReduceJob::kFloat16
+                                                                            : ReduceJob::kFloat32;
+    job.format = ReduceJob::Format(x_kind, std::min<uint32_t>(format.componentCount, 3),
+                                   static_cast<uint32_t>(std::max(builder::IndexTypeBytes(g.index_type), 0)));
     job.first_vertex = g.range.firstVertex;
     job.max_vertex = g.max_vertex;
     job.indices = indices;
@@ -43,6 +43,21 @@ ReduceJob MakeReduceJob(const CapturedGeometry& g, VkDeviceAddress data, VkDevic
     job.stride = sizeof(VkAccelerationStructureInstanceKHR);
   }
   return job;
+}
+
+// An indirect build's job: the shader reads the geometry's range info at `range` first (0: a direct build's).
+ReduceJob Indirect(ReduceJob job, VkDeviceAddress range) {
+  if (range == 0) return job;
+  job.kind |= ReduceJob::kIndirect;
+  job.range = range;
+  return job;
+}
+
+// What must lie in a bound buffer for the dispatch to read source s: all of it, or for an indirect build's geometry
+// (its offset and count on the device) where it starts, one word (the build reads from there what the dispatch
+// reads).
+VkDeviceSize ReadableExtent(const CaptureSource& s, VkDeviceAddress indirect_range) {
+  return indirect_range == 0 ? s.size : std::min<VkDeviceSize>(s.size, 4);
 }
 
 }  // namespace
@@ -103,8 +118,9 @@ bool Gatherable(const CapturedGeometry& g) {
 }
 
 bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
-                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why) {
-  if (!BoundBufferCovering(state, pointers.address, pointers.size)) {
+                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why,
+                            VkDeviceAddress indirect_range) {
+  if (!BoundBufferCovering(state, pointers.address, ReadableExtent(pointers, indirect_range))) {
     *why = CaptureSkip::kUnknownAddress;
     return false;
   }
@@ -121,7 +137,7 @@ bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedG
   const VkDeviceSize pointer_bytes = 8 * VkDeviceSize{g.range.primitiveCount};
   g.pointers = CapturedBytes{out.slab, out.offset, pointer_bytes, true};
   g.data = CapturedBytes{out.slab, out.offset + pointer_bytes, out.size - pointer_bytes, true};
-  AddJob(block, MakeReduceJob(g, pointers.address, 0, 0, log.AddressOf(out)));
+  AddJob(block, Indirect(MakeReduceJob(g, pointers.address, 0, 0, log.AddressOf(out)), indirect_range));
   return true;
 }
 
@@ -141,9 +157,9 @@ VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& source
 }
 
 bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
-                    JobBlock& block, CaptureSkip* why) {
+                    JobBlock& block, CaptureSkip* why, VkDeviceAddress indirect_range) {
   const auto readable = [&](const CaptureSource* s) {
-    return s && BoundBufferCovering(state, s->address, s->size).has_value();
+    return s && BoundBufferCovering(state, s->address, ReadableExtent(*s, indirect_range)).has_value();
   };
   const CaptureSource* indices = sources.indices;
   const CaptureSource* transform = readable(sources.transform) ? sources.transform : nullptr;  // optional
@@ -168,8 +184,9 @@ bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry&
   if (indices) g.indices = CapturedBytes{out.slab, out.offset + bits, hashes, true};
   if (transform) g.transform = CapturedBytes{out.slab, out.offset + bits + hashes, transform->size, true};
   g.reduced = true;
-  AddJob(block, MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
-                          transform ? transform->address : 0, log.AddressOf(out)));
+  AddJob(block, Indirect(MakeReduceJob(g, sources.data->address, indices ? indices->address : 0,
+                                       transform ? transform->address : 0, log.AddressOf(out)),
+                         indirect_range));
   return true;
 }
 

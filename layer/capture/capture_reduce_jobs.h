@@ -37,8 +37,12 @@ bool Gatherable(const CapturedGeometry& g);
 inline VkDeviceSize GatheredCost(const CapturedGeometry& g) {
   return GatheredBytes(g.range.primitiveCount) + sizeof(ReduceJob);
 }
+// `indirect_range`: an indirect build's geometry (ReduceJob::kIndirect), its range info's device address; g is then
+// planned for a range of offset 0 and the most primitives, and only where its bytes start must lie in a bound buffer
+// (how far the build reads from there is known on the device alone).
 bool GatherInstancePointers(const DeviceState& state, CaptureLog& log, CapturedGeometry& g,
-                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why);
+                            const CaptureSource& pointers, JobBlock& block, CaptureSkip* why,
+                            VkDeviceAddress indirect_range = 0);
 
 // Geometry g's sources among its planned ones [first, last): its data, and for triangles its indices and its
 // transform (each null when the plan has none).
@@ -55,7 +59,8 @@ VkDeviceSize ReducedCost(const CapturedGeometry& g, const ReducedSources& source
 // transform among them, where the builder's views find them), its job added to `block`. False when a source cannot
 // be read (no bound buffer holds it: *why kUnknownAddress; the transform is then left out instead) or there is no
 // room (kCaptureMemoryFailed): the info is then not captured.
+// `indirect_range` as for GatherInstancePointers.
 bool ReduceGeometry(const DeviceState& state, CaptureLog& log, CapturedGeometry& g, const ReducedSources& sources,
-                    JobBlock& block, CaptureSkip* why);
+                    JobBlock& block, CaptureSkip* why, VkDeviceAddress indirect_range = 0);
 
 }  // namespace asval

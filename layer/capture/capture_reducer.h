@@ -25,19 +25,26 @@ struct ReduceJob {
   // kGatherInstances: an array of instance pointers at `data` (count of them): the pointers and the records they
   // point to (those FollowedInstancePointer names; zeros for the others) copied to `out` (GatheredBytes).
   enum Kind : uint32_t { kTriangles = 0, kAabbs = 1, kInstances = 2, kGatherInstances = 3 };
+  // Or'ed into the kind: an indirect build's geometry, whose range info the shader reads at `range` (the addresses
+  // below are then those of a range of offset 0, `count` the most it may have: ppMaxPrimitiveCounts).
+  static constexpr uint32_t kIndirect = 256;
   enum XKind : uint32_t { kNoNaN = 0, kFloat32 = 1, kFloat16 = 2 };
+  // Triangles: how the vertex format's X can be NaN (XKind), its components (2 or 3) and the index bytes (0: not
+  // indexed, 1, 2, 4), in one word.
+  static constexpr uint32_t Format(XKind x_kind, uint32_t components, uint32_t index_bytes) {
+    return x_kind | components << 8 | index_bytes << 16;
+  }
   uint32_t kind = kTriangles;
   uint32_t count = 0;         // primitives
   uint32_t stride = 0;        // vertex, AABB or instance record stride
-  uint32_t x_kind = kNoNaN;   // triangles: how the vertex format's X can be NaN
-  uint32_t components = 3;    // triangles: 2 or 3
-  uint32_t index_bytes = 0;   // triangles: 0 (not indexed), 1, 2, 4
+  uint32_t format = Format(kNoNaN, 3, 0);
   uint32_t first_vertex = 0;  // indexed triangles
   uint32_t max_vertex = 0;    // indexed triangles: the highest vertex that may be read
   uint64_t data = 0;          // vertices (not indexed: the first one read), AABBs or instance records
   uint64_t indices = 0;       // indexed triangles: the first index read
   uint64_t out = 0;           // where the results go (ReducedGeometry, capture_log.h)
   uint64_t transform = 0;     // triangles: the transform, copied after the index hash (0: none, or not captured)
+  uint64_t range = 0;         // kIndirect: the geometry's range info
 };
 static_assert(sizeof(ReduceJob) == 64, "ReduceJob must match reduce_inputs.comp's Job");
 

@@ -113,7 +113,8 @@ void ReportInstanceTransforms(const CheckContext& ctx, const InstanceReferenceCh
   const CapturedInfo& info = *readable;
   const Location loc(OpCommandName(build.build.command));
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
-    const CapturedGeometry& g = log->geometries[info.first_geometry + j];
+    CapturedGeometry g;  // an indirect info's with its range as the device read it
+    if (!ExecutedGeometry(*log, info, j, &g)) continue;  // the instance rules counted it
     // Arrays of pointers: their gathered records (a record not followed is zeros: nothing to warn about).
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || !g.data.present) continue;
     const uint8_t* bytes = log->Bytes(g.data);

@@ -45,9 +45,15 @@ struct Referenced {
                       message);
 }
 
+// The rule about what an instance references: the indirect command's newest text of it is pInfos-12281 (its
+// pInfos-06707 is that rule's older name), the direct command's is pInfos-06707.
+const char* ReferenceRule(const InstanceReferenceCheck& c) {
+  return c.build.command == OpCommand::kCmdBuildIndirect ? "pInfos-12281" : "pInfos-06707";
+}
+
 [[gnu::cold]] void ReportStale(const CheckContext& ctx, const InstanceReferenceCheck& c, uint32_t geometry,
                                uint64_t bad, const std::string& named) {
-  Report(ctx, c, "pInfos-06707", VK_NULL_HANDLE,
+  Report(ctx, c, ReferenceRule(c), VK_NULL_HANDLE,
          fmt::format("{}: builds top-level {}; on execution, geometry {}: {} instance(s) reference no acceleration "
                      "structure that was alive when the build was submitted (not 0 and not an address "
                      "vkGetAccelerationStructureDeviceAddressKHR returned for a live structure): {}.",
@@ -56,7 +62,7 @@ struct Referenced {
 
 [[gnu::cold]] void ReportTopLevel(const CheckContext& ctx, const InstanceReferenceCheck& c, uint32_t geometry,
                                    uint64_t count, const std::string& named) {
-  Report(ctx, c, "pInfos-06707", VK_NULL_HANDLE,
+  Report(ctx, c, ReferenceRule(c), VK_NULL_HANDLE,
          fmt::format("{}: builds top-level {}; on execution, geometry {}: {} instance(s) reference a top-level "
                      "acceleration structure, but an instance must reference a bottom-level one (the top level takes "
                      "a reference to the bottom-level structures its instances reference; the indirect command's "
@@ -225,7 +231,11 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   std::vector<Referenced> first;
   if (per_structure) first.assign(live.structures.size(), Referenced{-1, 0, 0});
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
-    const CapturedGeometry& g = log->geometries[info.first_geometry + j];
+    CapturedGeometry g;  // an indirect info's with its range as the device read it
+    if (!ExecutedGeometry(*log, info, j, &g)) {
+      CountUnknownState(ctx);
+      continue;
+    }
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0) continue;
     if (g.array_of_pointers) {
       if (!g.pointers.present) continue;

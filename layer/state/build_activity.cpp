@@ -243,25 +243,26 @@ void BuildActivity::Fill(uint32_t spacing_permille) {
     return;
   }
   const CapturedInfo& info = *readable;
-  if (info.indirect) {  // only its range infos were captured: what it built from is not known
+  if (info.indirect && !info.indirect_geometry) {  // only its range infos were captured: what it built from is unknown
     MarkUnknown();
     return;
   }
   geometries_.resize(info.geometry_count);
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     builder::ClassifyResult result;
-    if (!Classify(*log, log->geometries[info.first_geometry + j], &geometries_[j], &result)) {
+    CapturedGeometry executed;  // an indirect info's with its range as the device read it
+    if (!ExecutedGeometry(*log, info, j, &executed) || !Classify(*log, executed, &geometries_[j], &result)) {
       geometries_.clear();
       undefined_.clear();
       MarkUnknown();
       return;
     }
-    const int transform_element = NonFiniteElement(*log, log->geometries[info.first_geometry + j]);
+    const int transform_element = NonFiniteElement(*log, executed);
     if (result.undefinedNaN != 0 || transform_element >= 0) {
       undefined_.push_back(UndefinedInput{j, result.undefinedNaN, result.firstUndefined, transform_element});
     }
   }
-  if (spacing_permille != 0) ScanSpacing(*log, info, spacing_permille);
+  if (spacing_permille != 0 && !info.indirect) ScanSpacing(*log, info, spacing_permille);  // indirect: reduced
   status_.store(Status::kReady, std::memory_order_release);
   log_.reset();
 }

@@ -1,5 +1,7 @@
 #include "capture_log.h"
 
+#include <cstring>
+
 namespace asval {
 
 namespace {
@@ -64,6 +66,32 @@ uint32_t CaptureLog::AddDestinations(const CommandDestination* command_destinati
   const auto first = static_cast<uint32_t>(destinations.size());
   destinations.insert(destinations.end(), command_destinations, command_destinations + count);
   return first;
+}
+
+bool ExecutedGeometry(const CaptureLog& log, const CapturedInfo& info, uint32_t j, CapturedGeometry* out) {
+  *out = log.geometries[info.first_geometry + j];
+  if (!info.indirect_geometry) return true;
+  if (!info.ranges.present || info.first_geometry + j >= log.max_primitive_counts.size()) return false;
+  VkAccelerationStructureBuildRangeInfoKHR range;
+  std::memcpy(&range, log.Bytes(info.ranges) + static_cast<std::size_t>(j) * info.indirect_stride, sizeof(range));
+  const uint32_t n = range.primitiveCount;
+  if (n > log.max_primitive_counts[info.first_geometry + j]) return false;
+  CapturedGeometry& g = *out;
+  // The offsets were applied on the device (reduce_inputs.comp): the results start where the dispatch wrote them.
+  g.range = builder::BuildRange{};
+  g.range.primitiveCount = n;
+  if (!g.data.present) return true;
+  if (g.array_of_pointers) {  // the pointers, then the records (GatheredBytes)
+    g.pointers = CapturedBytes{g.pointers.slab, g.pointers.offset, 8 * VkDeviceSize{n}, true};
+    g.data = CapturedBytes{g.pointers.slab, g.pointers.offset + g.pointers.size, 64 * VkDeviceSize{n}, true};
+    return true;
+  }
+  const VkDeviceSize bits = ReducedBitBytes(g.type, n);
+  const VkDeviceSize hashes = g.indices.present ? ReducedHashBytes(n) : 0;
+  g.data.size = ReducedBytes(g.type, n, g.indices.present, g.transform.present);
+  if (g.indices.present) g.indices = CapturedBytes{g.data.slab, g.data.offset + bits, hashes, true};
+  if (g.transform.present) g.transform = CapturedBytes{g.data.slab, g.data.offset + bits + hashes, 48, true};
+  return true;
 }
 
 }  // namespace asval

@@ -216,9 +216,22 @@ struct CapturedInfo {
   bool indirect = false;
   CapturedBytes ranges;
   uint32_t indirect_stride = 0;
+  // Indirect infos whose geometries the layer's dispatch also read (issue 28): each planned for the most
+  // primitives the build may read, its range info read on the device (ExecutedGeometry gives it as built). False:
+  // the range infos alone (what it built from is unknown).
+  bool indirect_geometry = false;
   // Every geometry's bytes are captured (else the info's activity is unknown: counted, never guessed).
   bool complete = true;
 };
+
+class CaptureLog;
+
+// Geometry j of a captured info as the build read it: for an indirect info whose geometries were captured
+// (CapturedInfo::indirect_geometry), the planned geometry with its range info as the device read it (copied into
+// CapturedInfo::ranges) and the bytes the layer's dispatch laid out for that range's count; else the geometry as
+// logged. False when the count is above ppMaxPrimitiveCounts (the dispatch read no more than the maximum: what the
+// build read is unknown; the count's own rule reports it) or the range infos were not captured.
+bool ExecutedGeometry(const CaptureLog& log, const CapturedInfo& info, uint32_t j, CapturedGeometry* out);
 
 class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
  public:

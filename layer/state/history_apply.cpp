@@ -181,7 +181,11 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
   if (op.origin.command == OpCommand::kCmdBuildIndirect) {
     captures.indirect_checks.push_back(IndirectCheck(store, op, log));
   }
-  if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && op.origin.command != OpCommand::kCmdBuildIndirect) {
+  // An indirect build's instances are known where the layer's dispatch read them (CapturedInfo::indirect_geometry).
+  const bool instances_captured =
+      op.origin.command != OpCommand::kCmdBuildIndirect ||
+      (op.capture_info < log->infos.size() && log->infos[op.capture_info].indirect_geometry);
+  if (op.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR && instances_captured) {
     InstanceReferenceCheck check;
     check.log = log->shared_from_this();
     check.info = op.capture_info;

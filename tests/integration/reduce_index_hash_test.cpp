@@ -26,15 +26,15 @@ struct Job {
   uint32_t kind = 0;  // triangles
   uint32_t count = 0;
   uint32_t stride = 12;
-  uint32_t x_kind = 0;  // no NaN test: the vertices are not read
-  uint32_t components = 3;
-  uint32_t index_bytes = 0;
+  // x_kind (bits 0-7) 0: no NaN test, the vertices are not read; components (bits 8-15) 3; index_bytes (bits 16-23).
+  uint32_t format = 3u << 8;
   uint32_t first_vertex = 0;
   uint32_t max_vertex = 0xffffffffu;  // every index readable
   uint64_t data = 0;
   uint64_t indices = 0;
   uint64_t out = 0;
   uint64_t transform = 0;
+  uint64_t range = 0;  // not an indirect build's job
 };
 static_assert(sizeof(Job) == 64, "the shader's job is 64 bytes");
 
@@ -126,7 +126,7 @@ TEST_CASE("reduce index hash: the device's hash of each 64 triangles' indices is
     CAPTURE(c.index_bytes, c.offset, c.triangles, c.groups);
     Job j;
     j.count = c.triangles;
-    j.index_bytes = c.index_bytes;
+    j.format |= c.index_bytes << 16;
     j.indices = indices.address + c.offset;
     j.data = indices.address;  // not read (x_kind 0)
     j.out = out.address;

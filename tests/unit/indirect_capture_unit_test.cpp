@@ -515,3 +515,78 @@ TEST_CASE("indirect capture unit: the recorder keeps each geometry's range facts
 
 }  // namespace
 }  // namespace asval::test
+
+namespace asval::test {
+namespace {
+
+// An indexed triangle geometry of an indirect info whose geometry the layer's dispatch reduced (issue 28): planned
+// for `max` primitives, its results at byte 1024 of slab 0, with the index hash and the transform.
+IndirectLog ReducedIndirect(uint32_t count, uint32_t max) {
+  CapturedGeometry g = Triangles(VK_FORMAT_R32G32B32_SFLOAT, VK_INDEX_TYPE_UINT32, 3 * max - 1);
+  g.reduced = true;
+  g.range.primitiveCount = max;
+  g.data = CapturedBytes{0, 1024, 4096, true};
+  g.indices = CapturedBytes{0, 1024 + 60, 48, true};   // where the plan for `max` put them: not read
+  g.transform = CapturedBytes{0, 1024 + 108, 48, true};
+  IndirectLog made({Range{count, 36, 2, 16}}, {g}, {max}, 16);
+  made.log->infos[0].indirect_geometry = true;
+  return made;
+}
+
+TEST_CASE("indirect capture unit: an indirect geometry is read as the device laid it out for the range info's count",
+          "[unit][capture]") {
+  const IndirectLog made = ReducedIndirect(40, 100);
+  CapturedGeometry g;
+  REQUIRE(ExecutedGeometry(*made.log, made.log->infos[0], 0, &g));
+  CHECK(g.range.primitiveCount == 40);
+  // The offsets were applied on the device: none is left to apply.
+  CHECK(g.range.primitiveOffset == 0);
+  CHECK(g.range.firstVertex == 0);
+  CHECK(g.range.transformOffset == 0);
+  // 40 triangles: three bit arrays of two words (24 bytes), then one index hash block (16), then the transform.
+  CHECK(g.data.offset == 1024);
+  CHECK(g.indices.offset == 1024 + 24);
+  CHECK(g.indices.size == 16);
+  CHECK(g.transform.offset == 1024 + 24 + 16);
+  CHECK(g.transform.size == 48);
+  CHECK(g.data.size == 24 + 16 + 48);
+}
+
+TEST_CASE("indirect capture unit: an indirect geometry whose count is above ppMaxPrimitiveCounts is unknown",
+          "[unit][capture]") {
+  const IndirectLog made = ReducedIndirect(101, 100);
+  CapturedGeometry g;
+  CHECK_FALSE(ExecutedGeometry(*made.log, made.log->infos[0], 0, &g));
+  const IndirectLog at_most = ReducedIndirect(100, 100);
+  CHECK(ExecutedGeometry(*at_most.log, at_most.log->infos[0], 0, &g));
+}
+
+TEST_CASE("indirect capture unit: an indirect array of instance pointers is read as gathered for the range's count",
+          "[unit][capture]") {
+  CapturedGeometry g = Facts(VK_GEOMETRY_TYPE_INSTANCES_KHR);
+  g.array_of_pointers = true;
+  g.range.primitiveCount = 8;
+  g.pointers = CapturedBytes{0, 2048, 64, true};
+  g.data = CapturedBytes{0, 2048 + 64, 512, true};
+  IndirectLog made({Range{3, 0, 0, 0}}, {g}, {8}, 16);
+  made.log->infos[0].indirect_geometry = true;
+  CapturedGeometry out;
+  REQUIRE(ExecutedGeometry(*made.log, made.log->infos[0], 0, &out));
+  CHECK(out.range.primitiveCount == 3);
+  CHECK(out.pointers.offset == 2048);
+  CHECK(out.pointers.size == 24);      // 3 pointers
+  CHECK(out.data.offset == 2048 + 24);  // then their records
+  CHECK(out.data.size == 192);
+}
+
+TEST_CASE("indirect capture unit: without its geometry captured, an indirect info's geometry is as logged",
+          "[unit][capture]") {
+  const IndirectLog made({5}, {8}, 16);  // range infos only
+  CapturedGeometry g;
+  REQUIRE(ExecutedGeometry(*made.log, made.log->infos[0], 0, &g));
+  CHECK(g.range.primitiveCount == 0);  // the facts only: its bytes stay absent
+  CHECK_FALSE(g.data.present);
+}
+
+}  // namespace
+}  // namespace asval::test

@@ -37,19 +37,20 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer Add
 
 // Must match ReduceJob (layer/capture/capture_reducer.h).
 struct Job {
-  uint kind;          // 0 triangles, 1 AABBs, 2 instances, 3 arrays of instance pointers (gathered)
-  uint count;         // primitives
+  uint kind;          // 0 triangles, 1 AABBs, 2 instances, 3 arrays of instance pointers (gathered); | 256: indirect
+  uint count;         // primitives (indirect: the most, ppMaxPrimitiveCounts)
   uint stride;        // vertex, AABB or instance stride in bytes
-  uint x_kind;        // triangles: 0 no NaN (normalized formats), 1 float32, 2 float16
-  uint components;    // triangles: 2 or 3 (Y and Z tested for the undefined-input bit)
-  uint index_bytes;   // triangles: 0 (not indexed), 1, 2 or 4
+  uint format;        // triangles: x_kind | components << 8 | index_bytes << 16 (below)
   uint first_vertex;  // indexed triangles: added to each index
   uint max_vertex;    // indexed triangles: the highest vertex that may be read
   uvec2 data;         // vertices (not indexed: the first one read), AABBs or instance records
   uvec2 indices;      // indexed triangles: the first index read
   uvec2 out_addr;     // results
   uvec2 transform;    // triangles: the transform (0: none, or not captured)
+  uvec2 range;        // indirect: the geometry's VkAccelerationStructureBuildRangeInfoKHR, where the build reads it
 };
+// Job::format: x_kind 0 no NaN (normalized formats), 1 float32, 2 float16; components 2 or 3 (Y and Z tested for
+// the undefined-input bit); index_bytes 0 (not indexed), 1, 2 or 4.
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer JobRef { Job job; };
 
 uvec2 Add64(uvec2 a, uint lo, uint hi) {
@@ -134,14 +135,38 @@ shared uvec2 s_lanes[4];
 void main() {
   const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
   const uvec2 slab = Addresses(uvec2(kTableLo, kTableHi)).a[job_index >> 16];
-  const Job job = JobRef(AddProduct(slab, job_index & 0xffffu, 64u)).job;
+  Job job = JobRef(AddProduct(slab, job_index & 0xffffu, 64u)).job;
+  // An indirect build's geometry (issue 28): where its bytes start and how many primitives it has are in its range
+  // info, on the device, read here where the build read it (after the build: nothing wrote it in between). The
+  // addresses of the job are then those of a range of offset 0, and its count the most the build may read; the
+  // results are laid out for the range's own count (the host reads that count from the range info it copied).
+  if ((job.kind & 256u) != 0u) {
+    const uint count = LoadBytes(job.range, 4u);
+    const uint primitive_offset = LoadBytes(Add64(job.range, 4u, 0u), 4u);
+    const uint first_vertex = LoadBytes(Add64(job.range, 8u, 0u), 4u);
+    const uint transform_offset = LoadBytes(Add64(job.range, 12u, 0u), 4u);
+    job.count = min(job.count, count);
+    job.kind &= 255u;
+    if (job.kind == 0u && ((job.format >> 16) & 255u) != 0u) {  // indexed: indices from the offset
+      job.indices = Add64(job.indices, primitive_offset, 0u);
+      job.first_vertex = first_vertex;
+    } else if (job.kind == 0u) {  // not indexed: vertices from the offset, firstVertex of them on
+      job.data = AddProduct(Add64(job.data, primitive_offset, 0u), first_vertex, job.stride);
+    } else {
+      job.data = Add64(job.data, primitive_offset, 0u);
+    }
+    if (job.transform != uvec2(0u)) job.transform = Add64(job.transform, transform_offset, 0u);
+  }
+  const uint x_kind = job.format & 255u;
+  const uint components = (job.format >> 8) & 255u;
+  const uint index_bytes = (job.format >> 16) & 255u;
   const uint words = (job.count + 31u) / 32u;
   const uint local = gl_LocalInvocationID.x;
   const uint stride_x = gl_NumWorkGroups.x * 64u;
   // Triangles: after the bit arrays, indexed ones the index hash's blocks (16 bytes per 64 triangles, written in
   // the loop below), then the transform, copied.
-  const uint index_total = 3u * job.count * job.index_bytes;
-  const uint hash_blocks = job.index_bytes != 0u ? (job.count + 63u) / 64u : 0u;
+  const uint index_total = 3u * job.count * index_bytes;
+  const uint hash_blocks = index_bytes != 0u ? (job.count + 63u) / 64u : 0u;
   const uvec2 out_hashes = AddProduct(job.out_addr, 3u * words, 4u);
   if (job.kind == 0u && gl_WorkGroupID.x == 0u && local < 12u && job.transform != uvec2(0u)) {
     const uvec2 out_transform = AddProduct(out_hashes, hash_blocks, 16u);
@@ -179,27 +204,27 @@ void main() {
       if (job.kind == 0u) {
         uint v[3];
         for (uint k = 0u; k < 3u; ++k) {
-          if (job.index_bytes == 0u) {
+          if (index_bytes == 0u) {
             v[k] = 3u * t + k;
           } else {
-            const uint index = LoadBytes(AddProduct(job.indices, 3u * t + k, job.index_bytes), job.index_bytes);
+            const uint index = LoadBytes(AddProduct(job.indices, 3u * t + k, index_bytes), index_bytes);
             uint carry;
             v[k] = uaddCarry(index, job.first_vertex, carry);
             unreadable = unreadable || carry != 0u || v[k] > job.max_vertex;
           }
         }
         bool x_nan = false, yz_nan = false;
-        if (!unreadable && job.x_kind != 0u) {
+        if (!unreadable && x_kind != 0u) {
           for (uint k = 0u; k < 3u; ++k) {
             const uvec2 p = AddProduct(job.data, v[k], job.stride);
-            if (job.x_kind == 1u) {
+            if (x_kind == 1u) {
               x_nan = x_nan || NaN32(LoadBytes(p, 4u));
               yz_nan = yz_nan || NaN32(LoadBytes(Add64(p, 4u, 0u), 4u));
-              if (job.components > 2u) yz_nan = yz_nan || NaN32(LoadBytes(Add64(p, 8u, 0u), 4u));
+              if (components > 2u) yz_nan = yz_nan || NaN32(LoadBytes(Add64(p, 8u, 0u), 4u));
             } else {
               x_nan = x_nan || NaN16(LoadBytes(p, 2u));
               yz_nan = yz_nan || NaN16(LoadBytes(Add64(p, 2u, 0u), 2u));
-              if (job.components > 2u) yz_nan = yz_nan || NaN16(LoadBytes(Add64(p, 4u, 0u), 2u));
+              if (components > 2u) yz_nan = yz_nan || NaN16(LoadBytes(Add64(p, 4u, 0u), 2u));
             }
           }
         }
@@ -235,13 +260,13 @@ void main() {
       if (unreadable) atomicOr(s_bits[2][local / 32u], bit);
     }
     // Indexed triangles: these 64 triangles' indices hashed, one lane per invocation (each lane is a chain).
-    const uint block_first = 3u * group_first * job.index_bytes;
-    const uint block_bytes = min(192u * job.index_bytes, index_total - min(block_first, index_total));
-    if (job.kind == 0u && job.index_bytes != 0u && local < 4u) {
-      s_lanes[local] = IndexHashLane(Add64(job.indices, block_first, 0u), block_bytes, job.index_bytes, local);
+    const uint block_first = 3u * group_first * index_bytes;
+    const uint block_bytes = min(192u * index_bytes, index_total - min(block_first, index_total));
+    if (job.kind == 0u && index_bytes != 0u && local < 4u) {
+      s_lanes[local] = IndexHashLane(Add64(job.indices, block_first, 0u), block_bytes, index_bytes, local);
     }
     barrier();
-    if (job.kind == 0u && job.index_bytes != 0u && local == 0u) {  // IndexHasher::Finish
+    if (job.kind == 0u && index_bytes != 0u && local == 0u) {  // IndexHasher::Finish
       const uvec2 total = uvec2(block_bytes, 0u);
       const uvec2 a = Fmix64(s_lanes[0] ^ Rotl64(s_lanes[2], 23u) ^ total);
       const uvec2 b = Fmix64(s_lanes[1] ^ Rotl64(s_lanes[3], 41u) ^ Mul64(total, kPrime[0]));
