@@ -137,6 +137,16 @@ bool ValidateIndexedVertexCount(const CheckContext& ctx, const BuildCommand& cmd
 
 namespace {
 
+// ppBuildRangeInfos-03676: ppBuildRangeInfos[i] points to pInfos[i].geometryCount range infos. What the layer can see
+// of that: a null element where the info has geometries (a pointer that is not null is taken as valid).
+[[gnu::cold, gnu::noinline]] bool ReportNullRanges(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i) {
+  return ReportBuild(ctx, cmd, i, "ppBuildRangeInfos-03676",
+                     [&](std::string&) { return cmd.Root().Field("ppBuildRangeInfos", i); },
+                     "is NULL, but pInfos[{}].geometryCount is {}: it must point to that many "
+                     "VkAccelerationStructureBuildRangeInfoKHR structures.",
+                     i, cmd.infos[i].geometryCount);
+}
+
 // The infos the command's geometry pass flagged for these rules, walked with the reporting judge (out of line:
 // the clean path only tests the flags).
 [[gnu::noinline]] bool WalkRanges(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved) {
@@ -147,7 +157,12 @@ namespace {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
     const VkAccelerationStructureBuildRangeInfoKHR* ranges = cmd.ranges[i];
     // Infos in which the command's geometry pass found nothing for these rules are not walked again.
-    if (!(resolved.info(i).walks & kWalkRanges) || !ranges || !GeometriesWalkable(ctx, info)) continue;
+    if (!(resolved.info(i).walks & kWalkRanges)) continue;
+    if (!ranges) {
+      if (info.geometryCount != 0) skip |= ReportNullRanges(ctx, cmd, i);
+      continue;
+    }
+    if (!GeometriesWalkable(ctx, info)) continue;
     for (uint32_t j = 0; j < info.geometryCount; ++j) {
       const VkAccelerationStructureGeometryKHR* geometry = GeometryAt(info, j);
       if (geometry) skip |= RangeRules(ctx, cmd, i, j, facts.Read(*geometry), ranges[j], judge);

@@ -157,3 +157,34 @@ TEST_CASE("vertex counts valid twin: maxVertex that covers firstVertex and the l
 
 }  // namespace
 }  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+constexpr const char* k03676Direct = "VUID-vkCmdBuildAccelerationStructuresKHR-ppBuildRangeInfos-03676";
+
+TEST_CASE("ppBuildRangeInfos-03676: a NULL element of ppBuildRangeInfos for an info with geometries is reported",
+          "[integration][structure][03676]") {
+  CheckFixture f("structure");
+  Scene scene(f.device());
+  OneRange plain(scene, scene.Triangles());
+  f.monitor().Expect(k03676Direct);
+  IssueOne(f.device(), Command::kDirect, plain.info, nullptr);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("ppBuildRangeInfos-03676 valid twin: range infos for every info with geometries, none for one without",
+          "[integration][structure][valid]") {
+  CheckFixture f;
+  Scene scene(f.device());
+  OneRange plain(scene, scene.Triangles());
+  plain.Issue(f, Command::kDirect, {1, 0, 0, 0});
+  VkAccelerationStructureBuildGeometryInfoKHR empty = plain.info;
+  empty.geometryCount = 0;  // a structure of no geometry: nothing to point to
+  empty.pGeometries = nullptr;
+  IssueOne(f.device(), Command::kDirect, empty, nullptr);
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test

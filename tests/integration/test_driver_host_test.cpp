@@ -83,3 +83,38 @@ TEST_CASE(
 
 }  // namespace
 }  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+constexpr const char* k03676Host = "VUID-vkBuildAccelerationStructuresKHR-ppBuildRangeInfos-03676";
+
+TEST_CASE("ppBuildRangeInfos-03676 on the test driver: a host build whose ppBuildRangeInfos[i] is NULL for an info "
+          "with geometries is reported",
+          "[integration][structure][test-driver][03676]") {
+  const OnTestDriver driver;
+  CheckFixture f("structure", OnTestDriver::HostCommands());
+  Scene scene(f.device());
+  HostBuild build(scene, scene.Triangles());
+  f.monitor().Expect(k03676Host);
+  CallHostBuild(f.device(), {build.info}, {nullptr});
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("ppBuildRangeInfos-03676 valid twin on the test driver: host builds whose infos with geometries have "
+          "their range infos stay silent and execute",
+          "[integration][structure][test-driver][valid]") {
+  const OnTestDriver driver;
+  CheckFixture f("structure", OnTestDriver::HostCommands());
+  vkkit::Device& device = f.device();
+  Scene scene(device);
+  HostBuild first(scene, scene.Triangles());
+  HostBuild second(scene, scene.Aabbs());
+  REQUIRE(CallHostBuild(device, {first.info, second.info}, {&first.range, &second.range}) == VK_SUCCESS);
+  CHECK(SerializedSize(device, first.info.dstAccelerationStructure) != 0);
+  CHECK(SerializedSize(device, second.info.dstAccelerationStructure) != 0);
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test
