@@ -19,6 +19,9 @@ struct Case {
   const char* pattern;  // what the program does, in one sentence
   std::vector<std::string> expected;  // the VUIDs it must trigger, newest spelling; empty: valid, must stay silent
   CaseBody body;
+  // A case that needs what only asval's test driver executes (tests/driver): the features its device enables
+  // ("host-commands", "indirect-build", comma-separated); run_corpus.py runs it there. Null: lavapipe.
+  const char* test_driver = nullptr;
 };
 
 // Every case of the program, in registration order.
@@ -33,6 +36,13 @@ struct Registrar {
 };
 
 }  // namespace corpus
+
+// CORPUS_CASE_ON_TEST_DRIVER(function, "name", "family", "features", "pattern", {"VUID-...", ...}) { body }: a case
+// that runs on asval's test driver, its device enabling those features (Case::test_driver).
+#define CORPUS_CASE_ON_TEST_DRIVER(function, name, family, features, pattern, ...)                           \
+  static void function(vkkit::Device& device);                                                                \
+  static const corpus::Registrar function##_registrar({name, family, pattern, __VA_ARGS__, &function, features}); \
+  static void function([[maybe_unused]] vkkit::Device& device)
 
 // CORPUS_CASE(function, "name", "family", "pattern", {"VUID-...", ...}) { body using `device` }
 #define CORPUS_CASE(function, name, family, pattern, ...)                                          \

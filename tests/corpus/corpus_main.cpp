@@ -46,8 +46,10 @@ void List() {
     const Case& c = cases[i];
     std::string expected;
     for (const std::string& vuid : c.expected) expected += (expected.empty() ? "" : ", ") + Json(vuid);
-    std::printf("  {\"name\": %s, \"family\": %s, \"pattern\": %s, \"expected\": [%s]}%s\n", Json(c.name).c_str(),
-                Json(c.family).c_str(), Json(c.pattern).c_str(), expected.c_str(), i + 1 < cases.size() ? "," : "");
+    const std::string driver = c.test_driver ? ", \"test_driver\": " + Json(c.test_driver) : "";
+    std::printf("  {\"name\": %s, \"family\": %s, \"pattern\": %s, \"expected\": [%s]%s}%s\n", Json(c.name).c_str(),
+                Json(c.family).c_str(), Json(c.pattern).c_str(), expected.c_str(), driver.c_str(),
+                i + 1 < cases.size() ? "," : "");
   }
   std::printf("]\n");
 }
@@ -69,6 +71,18 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT seve
     return mode && std::strcmp(mode, "report-only") == 0;
   }();
   return error && !report_only ? VK_TRUE : VK_FALSE;
+}
+
+// ASVAL_CORPUS_DEVICE_FEATURES: the acceleration-structure features the case's device enables beyond the default,
+// "host-commands" and / or "indirect-build" (run_corpus.py asks for them where the case runs on asval's test
+// driver, which has both: tests/driver).
+vkkit::DeviceOptions OptionsFromEnvironment() {
+  vkkit::DeviceOptions options;
+  const char* env = std::getenv("ASVAL_CORPUS_DEVICE_FEATURES");
+  const std::string features = env ? env : "";
+  options.host_commands = features.find("host-commands") != std::string::npos;
+  options.indirect_build = features.find("indirect-build") != std::string::npos;
+  return options;
 }
 
 int Run(const Case& c) {
@@ -94,7 +108,7 @@ int Run(const Case& c) {
   }
   current_instance = &instance;
   {
-    vkkit::Device device(instance, gpu);
+    vkkit::Device device(instance, gpu, OptionsFromEnvironment());
     c.body(device);
   }
   current_instance = nullptr;  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too

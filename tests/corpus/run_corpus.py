@@ -35,6 +35,14 @@ KHRONOS_MANIFEST_DIR = "/usr/share/vulkan/explicit_layer.d"
 ASVAL = "VK_LAYER_ASVAL_as_validation"
 KHRONOS = "VK_LAYER_KHRONOS_validation"
 LVP_ICD = "/usr/share/vulkan/icd.d/lvp_icd.json"
+TEST_DRIVER = "VK_LAYER_ASVAL_test_driver"
+# The rules a host or indirect build breaks on a device without the feature (lavapipe): a case labelled with one of
+# these runs again on asval's test driver (tests/driver), whose device enables the feature, labelled without it.
+FEATURE_RULES = {
+    "VUID-vkBuildAccelerationStructuresKHR-accelerationStructureHostCommands-03581": "host-commands",
+    "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-accelerationStructureIndirectBuild-03650": "indirect-build",
+}
+DRIVER_SUFFIX = "@test-driver"
 TIMEOUT_S = 120
 
 
@@ -78,7 +86,10 @@ def list_cases(corpus, scene):
         label_families = [families[v] for v in c["expected"] if v in families]
         if label_families and c["family"] not in label_families:
             c["family"] = label_families[0]
+        if c.get("test_driver"):
+            c["family"] += DRIVER_SUFFIX
         cases.append(c)
+    cases += test_driver_twins(cases)
     if scene:
         out = subprocess.run([scene, "--list-faults"], stdout=subprocess.PIPE, universal_newlines=True,
                              check=True).stdout
@@ -93,6 +104,41 @@ def list_cases(corpus, scene):
                       "pattern": "the sample scene, 4 frames: refits, TLAS updates and rebuilds, tracing",
                       "command": [scene, "--frames", "4", "--instances", "500"]})
     return cases
+
+
+def test_driver_twins(cases):
+    """The host and indirect cases again on asval's test driver, a layer placed last over lavapipe that executes host
+    and indirect builds (docs/testing.md): the device enables the feature, and the label drops the feature's rule. A
+    case about the missing feature alone is left out (it has nothing else to report), except the valid twins of the
+    host family ("feature-only"), which become valid programs there. Every layer of a configuration sits above the
+    test driver."""
+    twins = []
+    for c in cases:
+        features = [FEATURE_RULES[v] for v in c["expected"] if v in FEATURE_RULES]
+        if not features:
+            continue
+        expected = [v for v in c["expected"] if v not in FEATURE_RULES]
+        if not expected and "feature-only" not in c["name"]:
+            continue
+        twins.append(dict(c, name=c["name"] + DRIVER_SUFFIX, family=c["family"] + DRIVER_SUFFIX, expected=expected,
+                          test_driver=",".join(features),
+                          pattern=c["pattern"] + " (on the test driver, the feature enabled)"))
+    return twins
+
+
+def case_env(case, env):
+    """A configuration's environment for one case: on the test driver, that layer last and the device's features.
+    The test driver sits over lavapipe, a CPU device, where asval's capture_method auto copies and so cannot read what
+    an indirect build's range infos select (docs/capture.md); indirect builds exist on GPUs, where auto reduces: the
+    cases there run asval as it runs on a GPU (capture_method reduce), unless the configuration sets the method."""
+    if not case.get("test_driver"):
+        return env
+    layers = env["ASVAL_TEST_LAYERS"] + ":" + TEST_DRIVER
+    extra = {"ASVAL_TEST_LAYERS": layers, "VK_INSTANCE_LAYERS": layers,
+             "ASVAL_CORPUS_DEVICE_FEATURES": case["test_driver"]}
+    if "VK_ASVAL_AS_VALIDATION_CAPTURE_METHOD" not in env:
+        extra["VK_ASVAL_AS_VALIDATION_CAPTURE_METHOD"] = "reduce"
+    return dict(env, **extra)
 
 
 # The Khronos layer 1.3.239 predates VK_EXT_layer_settings: it reports a VkLayerSettingsCreateInfoEXT in
@@ -110,9 +156,9 @@ def khronos_settings_file():
     return path
 
 
-def configurations(layer_path, extra, driver_files):
+def configurations(layer_path, extra, driver_files, test_driver_path):
     base = {
-        "VK_LAYER_PATH": layer_path + ":" + KHRONOS_MANIFEST_DIR,
+        "VK_LAYER_PATH": ":".join([layer_path, KHRONOS_MANIFEST_DIR] + ([test_driver_path] if test_driver_path else [])),
         "VK_DRIVER_FILES": driver_files,
         "VK_LOADER_LAYERS_DISABLE": "~implicit~",
         "VK_LAYER_SETTINGS_PATH": "/nonexistent/vk_layer_settings.txt",  # default settings for every layer
@@ -227,6 +273,8 @@ def main():
     ap.add_argument("--config", action="append", default=[], help="NAME:ENV=VALUE,... an extra asval configuration")
     ap.add_argument("--no-khronos", action="store_true", help="leave the Khronos layer out")
     ap.add_argument("--driver-files", default=LVP_ICD, help="the ICD manifest (VK_DRIVER_FILES); default lavapipe")
+    ap.add_argument("--test-driver-path", help="the folder holding the test driver's layer manifest (tests/driver of "
+                    "the build): the host and indirect cases run there too (name" + DRIVER_SUFFIX + ")")
     ap.add_argument("--valid-only", action="append", default=[], metavar="CONFIG",
                     help="run only the valid cases under CONFIG (on a GPU that an uncaught invalid build may hang)")
     ap.add_argument("--cases", help="only the cases whose name starts with this")
@@ -238,9 +286,12 @@ def main():
 
     aliases = load_aliases()
     cases = list_cases(os.path.abspath(args.corpus), args.scene and os.path.abspath(args.scene))
+    if not args.test_driver_path:
+        cases = [c for c in cases if not c.get("test_driver")]
     if args.cases:
         cases = [c for c in cases if c["name"].startswith(args.cases)]
-    configs = configurations(os.path.abspath(args.layer_path), args.config, args.driver_files)
+    configs = configurations(os.path.abspath(args.layer_path), args.config, args.driver_files,
+                             args.test_driver_path and os.path.abspath(args.test_driver_path))
     kversion = khronos_version()
     if args.no_khronos or not kversion:
         del configs["khronos"]
@@ -251,7 +302,7 @@ def main():
     for c in cases:
         c["results"] = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = {pool.submit(run_case, c, configs[name]): (c, name) for c, name in jobs}
+        futures = {pool.submit(run_case, c, case_env(c, configs[name])): (c, name) for c, name in jobs}
         for future in concurrent.futures.as_completed(futures):
             c, name = futures[future]
             c["results"][name] = judge(c, future.result(), aliases)

@@ -15,6 +15,7 @@
 
 #include "capture_helpers.h"
 #include "history_helpers.h"
+#include "indirect_helpers.h"
 #include "on_test_driver.h"
 
 namespace asval_test {
@@ -28,113 +29,7 @@ constexpr const char* kStorageNotBound = "VUID-vkCmdBuildAccelerationStructuresI
 constexpr const char* kMisalignedPointer = "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-03717";
 constexpr const char* kReferencedDestination = "VUID-vkCmdBuildAccelerationStructuresIndirectKHR-None-03407";
 
-constexpr uint32_t kNan = 0x7fc00000u;
-constexpr VkDeviceSize kVertexBytes = 12;  // R32G32B32_SFLOAT, tightly packed (the helpers' vertexStride)
-
-uint32_t Bits(float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
-
-// Where component c (0: X) of vertex v lies in the inputs buffer.
-VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + kVertexBytes * v + 4 * c; }
-
-// Six vertices: triangles (0, 1, 2) and (3, 4, 5), unit right triangles at z = 0 and z = 1, moved by dx along X.
-std::vector<uint32_t> Vertices(float dx = 0) {
-  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-  std::vector<uint32_t> words;
-  for (uint32_t v = 0; v < 6; ++v) {
-    words.push_back(Bits(corner[v % 3][0] + dx));
-    words.push_back(Bits(corner[v % 3][1]));
-    words.push_back(Bits(static_cast<float>(v / 3)));
-  }
-  return words;
-}
-
-Shape Triangles(uint32_t count = 2) {
-  Shape s;
-  s.triangles = count;
-  return s;
-}
-
 std::vector<std::pair<const char*, const char*>> Reduced() { return {{"capture_method", "reduce"}}; }
-
-vkkit::DeviceOptions IndirectBuild() {
-  vkkit::DeviceOptions options;
-  options.indirect_build = true;
-  return options;
-}
-
-// A structure over inputs the device writes, built and updated by indirect builds whose range infos (one per
-// geometry of the shape) lie in an INDIRECT_BUFFER the test writes from the host before each submission.
-class IndirectRig {
- public:
-  explicit IndirectRig(HistoryFixture& f)
-      : device_(f.device()),
-        inputs_(device_, VK_BUFFER_USAGE_TRANSFER_DST_BIT),
-        blas_(device_, inputs_),
-        commands_(device_),
-        ranges_(device_.CreateBuffer(16 * sizeof(VkAccelerationStructureBuildRangeInfoKHR),
-                                     VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)),
-        indirect_(reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
-            vkGetDeviceProcAddr(device_.handle(), "vkCmdBuildAccelerationStructuresIndirectKHR"))) {}
-  ~IndirectRig() { device_.Destroy(ranges_); }
-
-  vkkit::Device& device() { return device_; }
-  Blas& blas() { return blas_; }
-  const Inputs& inputs() const { return inputs_; }
-
-  void Write(VkCommandBuffer cb, VkDeviceSize offset, const std::vector<uint32_t>& words) {
-    vkCmdUpdateBuffer(cb, inputs_.buffer().buffer, offset, words.size() * sizeof(uint32_t), words.data());
-  }
-  void Fill(VkCommandBuffer cb, VkDeviceSize offset, uint32_t word) {
-    vkCmdFillBuffer(cb, inputs_.buffer().buffer, offset, sizeof(uint32_t), word);
-  }
-
-  // The range infos the next indirect build reads, geometry j's at j * 16 (written now: the submission comes later).
-  void SetRanges(const std::vector<VkAccelerationStructureBuildRangeInfoKHR>& ranges) {
-    std::memcpy(ranges_.mapped, ranges.data(), ranges.size() * sizeof(ranges[0]));
-  }
-
-  // One indirect build (or update in place) of the shape's info, the writes recorded before it made visible;
-  // `max_count` is every geometry's ppMaxPrimitiveCounts (0: the shape's triangles).
-  void Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
-              uint32_t max_count = 0) {
-    InputsWritten(cb);
-    const BuildInfo built = blas_.Info(shape, mode);
-    const std::vector<uint32_t> max_counts(built.info.geometryCount, max_count != 0 ? max_count : shape.triangles);
-    const uint32_t* counts = max_counts.data();
-    const uint32_t stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
-    indirect_(cb, 1, &built.info, &ranges_.address, &stride, &counts);
-  }
-
-  // Records `record` into a new command buffer, submits it and waits for it.
-  void Run(const std::function<void(VkCommandBuffer)>& record) {
-    SubmitAndWait(device_, RecordWith(commands_, record));
-  }
-
-  // A build of the shape with `vertices` written first, its ranges the shape's own.
-  void Build(const Shape& shape, const std::vector<uint32_t>& vertices = Vertices()) {
-    SetRanges({ShapeRange(shape)});
-    Run([&](VkCommandBuffer cb) {
-      Write(cb, Component(0, 0), vertices);
-      Record(cb, shape, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-    });
-  }
-
-  static VkAccelerationStructureBuildRangeInfoKHR ShapeRange(const Shape& shape) {
-    return VkAccelerationStructureBuildRangeInfoKHR{shape.triangles, shape.primitive_offset, shape.first_vertex, 0};
-  }
-
- private:
-  vkkit::Device& device_;
-  Inputs inputs_;
-  Blas blas_;
-  Commands commands_;
-  vkkit::Buffer ranges_;
-  PFN_vkCmdBuildAccelerationStructuresIndirectKHR indirect_;
-};
 
 // Whether the structure's indirect updates are judged: one that now makes primitive `primitive` inactive (a NaN X
 // over `vertex`) must be reported. A valid twin's silence means something only if its updates were judged.
@@ -153,7 +48,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03664]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   REQUIRE(f.monitor().Verify() == "");
   CHECK(Probe(rig, f.monitor(), Triangles()) == "");
@@ -165,7 +60,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03663]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   std::vector<uint32_t> vertices = Vertices();
   vertices[0] = kNan;  // triangle 0 inactive
   rig.Build(Triangles(), vertices);
@@ -182,7 +77,7 @@ TEST_CASE("capture on the test driver: an indirect update with other index value
           "[integration][capture][test-driver][03768]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   Shape shape = Triangles();
   shape.index_type = VK_INDEX_TYPE_UINT32;
   const std::vector<uint32_t> indices = {0, 1, 2, 3, 4, 5};
@@ -206,7 +101,7 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   SECTION("not indexed") {
     rig.Build(Triangles());
     for (float dx : {0.25f, 0.5f}) {
@@ -242,7 +137,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03664]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   // One triangle: the second of the inputs' two, selected by the range info only (the recorded info cannot say).
   Shape shape = Triangles(1);
   SECTION("primitiveOffset") { shape.primitive_offset = 3 * kVertexBytes; }
@@ -262,67 +157,13 @@ TEST_CASE(
   CHECK(Probe(rig, f.monitor(), shape, 3, 0) == "");
 }
 
-// A top-level structure built by indirect builds over instances the test writes from the host.
-class IndirectTlas {
- public:
-  explicit IndirectTlas(vkkit::Device& device)
-      : device_(device),
-        tlas_(device),
-        commands_(device),
-        ranges_(device.CreateBuffer(2 * sizeof(VkAccelerationStructureBuildRangeInfoKHR),
-                                    VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)),
-        indirect_(reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
-            vkGetDeviceProcAddr(device.handle(), "vkCmdBuildAccelerationStructuresIndirectKHR"))) {}
-  ~IndirectTlas() { device_.Destroy(ranges_); }
-
-  // Builds the top level over `count` of the instances (the range info's count; the recorded maximum is 4), given
-  // as records or (`pointers`) as an array of pointers to them.
-  void Build(const vkkit::Buffer& instances, uint32_t count, bool pointers = false) {
-    const VkAccelerationStructureBuildRangeInfoKHR range{count, 0, 0, 0};
-    std::memcpy(ranges_.mapped, &range, sizeof(range));
-    BuildInfo built = tlas_.Info(instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-    built.geometries[0].geometry.instances.arrayOfPointers = pointers ? VK_TRUE : VK_FALSE;
-    const uint32_t max_count = 4;
-    const uint32_t* counts = &max_count;
-    const uint32_t stride = sizeof(range);
-    SubmitAndWait(device_, RecordWith(commands_, [&](VkCommandBuffer cb) {
-                    indirect_(cb, 1, &built.info, &ranges_.address, &stride, &counts);
-                  }));
-  }
-  Tlas& tlas() { return tlas_; }
-
-  // One indirect command of two infos: pInfos[0] builds `blas` (one triangle), pInfos[1] the top level over `count`
-  // of the instances.
-  void BuildTogether(const Blas& blas, const vkkit::Buffer& instances, uint32_t count) {
-    const VkAccelerationStructureBuildRangeInfoKHR ranges[2] = {{1, 0, 0, 0}, {count, 0, 0, 0}};
-    std::memcpy(ranges_.mapped, ranges, sizeof(ranges));
-    const BuildInfo bottom = blas.Info(Shape{});
-    const BuildInfo top = tlas_.Info(instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-    const VkAccelerationStructureBuildGeometryInfoKHR infos[2] = {bottom.info, top.info};
-    const VkDeviceAddress addresses[2] = {ranges_.address, ranges_.address + sizeof(ranges[0])};
-    const uint32_t strides[2] = {sizeof(ranges[0]), sizeof(ranges[0])};
-    const uint32_t bottom_max = 1, top_max = 4;
-    const uint32_t* counts[2] = {&bottom_max, &top_max};
-    SubmitAndWait(device_, RecordWith(commands_, [&](VkCommandBuffer cb) {
-                    indirect_(cb, 2, infos, addresses, strides, counts);
-                  }));
-  }
-
- private:
-  vkkit::Device& device_;
-  Tlas tlas_;
-  Commands commands_;
-  vkkit::Buffer ranges_;
-  PFN_vkCmdBuildAccelerationStructuresIndirectKHR indirect_;
-};
-
 TEST_CASE(
     "capture on the test driver: an indirect top-level build whose instance references a destroyed "
     "structure is reported (pInfos-12281)",
     "[integration][capture][test-driver][12281][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas gone(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
@@ -340,7 +181,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03709][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas lost(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { lost.Build(cb, Shape{}); });
@@ -358,7 +199,7 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas gone(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
@@ -379,7 +220,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03407][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas other(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
@@ -397,7 +238,7 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas other(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
@@ -445,7 +286,7 @@ TEST_CASE(
     "[integration][capture][test-driver][03717][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   IndirectTlas top(rig.device());
   // Instance 1's record 8 bytes past a 16-byte boundary (still aligned for the record's own members).
@@ -460,7 +301,7 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   Blas gone(rig.device(), rig.inputs());
   rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
@@ -481,7 +322,7 @@ TEST_CASE(
   if (CaptureReducedRun()) SKIP("capture_method=reduce: the layer's dispatch reads the geometry");
   const OnTestDriver driver;
   HistoryFixture f(nullptr, {{"capture_method", "copy"}}, IndirectBuild());
-  IndirectRig rig(f);
+  IndirectRig rig(f.device());
   rig.Build(Triangles());
   rig.SetRanges({IndirectRig::ShapeRange(Triangles())});
   rig.Run([&](VkCommandBuffer cb) {

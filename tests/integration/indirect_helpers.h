@@ -1,0 +1,178 @@
+#pragma once
+// Indirect builds that execute (on asval's test driver: lavapipe has none), for the integration tests and the
+// corpus: a bottom-level structure over inputs the device writes, built and updated by
+// vkCmdBuildAccelerationStructuresIndirectKHR from range infos the host writes, and a top-level structure built the
+// same way over instances. Each submission is waited for.
+#include <vulkan/vulkan.h>
+
+#include <cstring>
+#include <functional>
+#include <vector>
+
+#include "capture_helpers.h"
+#include "history_helpers.h"
+#include "vkkit.h"
+
+namespace asval_test {
+
+inline constexpr uint32_t kNan = 0x7fc00000u;     // the quiet NaN
+inline constexpr VkDeviceSize kVertexBytes = 12;  // R32G32B32_SFLOAT, tightly packed (the helpers' vertexStride)
+
+inline uint32_t Bits(float value) {
+  uint32_t bits;
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+
+// Where component c (0: X) of vertex v lies in the inputs buffer.
+inline VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + kVertexBytes * v + 4 * c; }
+
+// Six vertices: triangles (0, 1, 2) and (3, 4, 5), unit right triangles at z = 0 and z = 1, moved by dx along X.
+inline std::vector<uint32_t> Vertices(float dx = 0) {
+  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  std::vector<uint32_t> words;
+  for (uint32_t v = 0; v < 6; ++v) {
+    words.push_back(Bits(corner[v % 3][0] + dx));
+    words.push_back(Bits(corner[v % 3][1]));
+    words.push_back(Bits(static_cast<float>(v / 3)));
+  }
+  return words;
+}
+
+inline Shape Triangles(uint32_t count = 2) {
+  Shape s;
+  s.triangles = count;
+  return s;
+}
+
+inline vkkit::DeviceOptions IndirectBuild() {
+  vkkit::DeviceOptions options;
+  options.indirect_build = true;
+  return options;
+}
+
+// A structure over inputs the device writes, built and updated by indirect builds whose range infos (one per
+// geometry of the shape) lie in an INDIRECT_BUFFER the test writes from the host before each submission.
+class IndirectRig {
+ public:
+  explicit IndirectRig(vkkit::Device& device)
+      : device_(device),
+        inputs_(device_, VK_BUFFER_USAGE_TRANSFER_DST_BIT),
+        blas_(device_, inputs_),
+        commands_(device_),
+        ranges_(device_.CreateBuffer(16 * sizeof(VkAccelerationStructureBuildRangeInfoKHR),
+                                     VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)),
+        indirect_(reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
+            vkGetDeviceProcAddr(device_.handle(), "vkCmdBuildAccelerationStructuresIndirectKHR"))) {}
+  ~IndirectRig() { device_.Destroy(ranges_); }
+
+  vkkit::Device& device() { return device_; }
+  Blas& blas() { return blas_; }
+  const Inputs& inputs() const { return inputs_; }
+
+  void Write(VkCommandBuffer cb, VkDeviceSize offset, const std::vector<uint32_t>& words) {
+    vkCmdUpdateBuffer(cb, inputs_.buffer().buffer, offset, words.size() * sizeof(uint32_t), words.data());
+  }
+  void Fill(VkCommandBuffer cb, VkDeviceSize offset, uint32_t word) {
+    vkCmdFillBuffer(cb, inputs_.buffer().buffer, offset, sizeof(uint32_t), word);
+  }
+
+  // The range infos the next indirect build reads, geometry j's at j * 16 (written now: the submission comes later).
+  void SetRanges(const std::vector<VkAccelerationStructureBuildRangeInfoKHR>& ranges) {
+    std::memcpy(ranges_.mapped, ranges.data(), ranges.size() * sizeof(ranges[0]));
+  }
+
+  // One indirect build (or update in place) of the shape's info, the writes recorded before it made visible;
+  // `max_count` is every geometry's ppMaxPrimitiveCounts (0: the shape's triangles).
+  void Record(VkCommandBuffer cb, const Shape& shape, VkBuildAccelerationStructureModeKHR mode,
+              uint32_t max_count = 0) {
+    InputsWritten(cb);
+    const BuildInfo built = blas_.Info(shape, mode);
+    const std::vector<uint32_t> max_counts(built.info.geometryCount, max_count != 0 ? max_count : shape.triangles);
+    const uint32_t* counts = max_counts.data();
+    const uint32_t stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
+    indirect_(cb, 1, &built.info, &ranges_.address, &stride, &counts);
+  }
+
+  // Records `record` into a new command buffer, submits it and waits for it.
+  void Run(const std::function<void(VkCommandBuffer)>& record) {
+    SubmitAndWait(device_, RecordWith(commands_, record));
+  }
+
+  // A build of the shape with `vertices` written first, its ranges the shape's own.
+  void Build(const Shape& shape, const std::vector<uint32_t>& vertices = Vertices()) {
+    SetRanges({ShapeRange(shape)});
+    Run([&](VkCommandBuffer cb) {
+      Write(cb, Component(0, 0), vertices);
+      Record(cb, shape, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    });
+  }
+
+  static VkAccelerationStructureBuildRangeInfoKHR ShapeRange(const Shape& shape) {
+    return VkAccelerationStructureBuildRangeInfoKHR{shape.triangles, shape.primitive_offset, shape.first_vertex, 0};
+  }
+
+ private:
+  vkkit::Device& device_;
+  Inputs inputs_;
+  Blas blas_;
+  Commands commands_;
+  vkkit::Buffer ranges_;
+  PFN_vkCmdBuildAccelerationStructuresIndirectKHR indirect_;
+};
+
+// A top-level structure built by indirect builds over instances the test writes from the host.
+class IndirectTlas {
+ public:
+  explicit IndirectTlas(vkkit::Device& device)
+      : device_(device),
+        tlas_(device),
+        commands_(device),
+        ranges_(device.CreateBuffer(2 * sizeof(VkAccelerationStructureBuildRangeInfoKHR),
+                                    VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)),
+        indirect_(reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(
+            vkGetDeviceProcAddr(device.handle(), "vkCmdBuildAccelerationStructuresIndirectKHR"))) {}
+  ~IndirectTlas() { device_.Destroy(ranges_); }
+
+  // Builds the top level over `count` of the instances (the range info's count; the recorded maximum is 4), given
+  // as records or (`pointers`) as an array of pointers to them.
+  void Build(const vkkit::Buffer& instances, uint32_t count, bool pointers = false) {
+    const VkAccelerationStructureBuildRangeInfoKHR range{count, 0, 0, 0};
+    std::memcpy(ranges_.mapped, &range, sizeof(range));
+    BuildInfo built = tlas_.Info(instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    built.geometries[0].geometry.instances.arrayOfPointers = pointers ? VK_TRUE : VK_FALSE;
+    const uint32_t max_count = 4;
+    const uint32_t* counts = &max_count;
+    const uint32_t stride = sizeof(range);
+    SubmitAndWait(device_, RecordWith(commands_, [&](VkCommandBuffer cb) {
+                    indirect_(cb, 1, &built.info, &ranges_.address, &stride, &counts);
+                  }));
+  }
+  Tlas& tlas() { return tlas_; }
+
+  // One indirect command of two infos: pInfos[0] builds `blas` (one triangle), pInfos[1] the top level over `count`
+  // of the instances.
+  void BuildTogether(const Blas& blas, const vkkit::Buffer& instances, uint32_t count) {
+    const VkAccelerationStructureBuildRangeInfoKHR ranges[2] = {{1, 0, 0, 0}, {count, 0, 0, 0}};
+    std::memcpy(ranges_.mapped, ranges, sizeof(ranges));
+    const BuildInfo bottom = blas.Info(Shape{});
+    const BuildInfo top = tlas_.Info(instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    const VkAccelerationStructureBuildGeometryInfoKHR infos[2] = {bottom.info, top.info};
+    const VkDeviceAddress addresses[2] = {ranges_.address, ranges_.address + sizeof(ranges[0])};
+    const uint32_t strides[2] = {sizeof(ranges[0]), sizeof(ranges[0])};
+    const uint32_t bottom_max = 1, top_max = 4;
+    const uint32_t* counts[2] = {&bottom_max, &top_max};
+    SubmitAndWait(device_, RecordWith(commands_, [&](VkCommandBuffer cb) {
+                    indirect_(cb, 2, infos, addresses, strides, counts);
+                  }));
+  }
+
+ private:
+  vkkit::Device& device_;
+  Tlas tlas_;
+  Commands commands_;
+  vkkit::Buffer ranges_;
+  PFN_vkCmdBuildAccelerationStructuresIndirectKHR indirect_;
+};
+
+}  // namespace asval_test
