@@ -100,17 +100,44 @@ void ResolveDestinations(const DeviceState& state, uint32_t info_count,
   }
 }
 
-// The destinations of an indirect build command of several infos: their addresses (None-03407); the bytes each
-// build writes depend on the primitive counts on the device, so their spans stay unknown (03706 skipped, counted).
+// The destinations of an indirect build command of several infos: their addresses (None-03407) and the bytes each
+// build writes for ppMaxPrimitiveCounts (the size cache holds them: the command's validation looked them up), which
+// are the bytes it writes when the device's range infos hold those counts (judged at completion, ExecutedAccess:
+// dstAccelerationStructure-03706); `captured` (per info, its log index plus one) names where those range infos are.
 void ResolveIndirectDestinations(const DeviceState& state, uint32_t info_count,
                                  const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                                 std::vector<CommandDestination>& out) {
+                                 const uint32_t* const* max_counts, std::vector<CommandDestination>& out) {
   out.assign(info_count, CommandDestination{});
   for (uint32_t i = 0; i < info_count; ++i) {
-    out[i].handle = infos[i].dstAccelerationStructure;
-    out[i].element = i;
-    if (const std::optional<StructureMemory> memory = MemoryOfStructure(state, out[i].handle)) {
-      out[i].address = memory->structure->device_address;
+    CommandDestination& d = out[i];
+    d.handle = infos[i].dstAccelerationStructure;
+    d.element = i;
+    d.indirect = true;
+    const std::optional<StructureMemory> memory = MemoryOfStructure(state, d.handle);
+    if (!memory) continue;
+    d.address = memory->structure->device_address;
+    if (infos[i].geometryCount != 0 && !max_counts[i]) continue;
+    if (!GeometryCountWithinLimit(infos[i], state.properties.acceleration_structure.maxGeometryCount)) continue;
+    BuildSignature signature;
+    signature.info = &infos[i];
+    signature.counts = max_counts[i];
+    signature.count_stride = sizeof(uint32_t);
+    BuildSizes sizes;
+    if (infos[i].geometryCount != 0 && !state.build_sizes.Find(signature, &sizes)) continue;
+    if (std::optional<MemorySpan> span = memory->Span(sizes.acceleration_structure_size)) d.accessed = *span;
+  }
+}
+
+// Where each destination's range infos were logged (ResolveIndirectDestinations): infos [0, through) of the command
+// so far, `captured` holding each one's log index plus one (0: not logged).
+void NoteCountsInfos(CaptureLog& log, uint32_t first_destination, uint32_t through, const std::vector<uint32_t>& captured,
+                     const VkAccelerationStructureBuildGeometryInfoKHR* infos) {
+  for (uint32_t k = 0; k < through && k < captured.size(); ++k) {
+    CommandDestination& d = log.destinations[first_destination + k];
+    if (captured[k] != 0) {
+      d.counts_info = captured[k] - 1;
+    } else if (infos[k].geometryCount != 0) {
+      d.accessed = MemorySpan{};  // its counts are not known: neither are the bytes it writes
     }
   }
 }
@@ -281,7 +308,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
           geometry_bytes = 0;
         } else if (info_count > 1 && infos[i].type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
           if (!destinations_logged) {  // once per command, shared by its top-level infos
-            ResolveIndirectDestinations(ctx.state, info_count, infos, destinations);
+            ResolveIndirectDestinations(ctx.state, info_count, infos, max_primitive_counts, destinations);
             first_destination = log.AddDestinations(destinations.data(), info_count);
             destinations_logged = true;
           }
@@ -292,6 +319,10 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
       }
       captured[i] =
           log.AddInfo(entry, planned.data(), max_primitive_counts[i], SaturatingAddBytes(bytes, geometry_bytes));
+    }
+    if (destinations_logged) {  // every info now logged: where each destination's counts are
+      NoteCountsInfos(recording.CaptureLogFor(ctx.pool.shared_from_this()), first_destination, info_count, captured,
+                      infos);
     }
     KeepOpen(ctx, run, copies_before);
     counts.AddTo(ctx.counters);

@@ -123,19 +123,21 @@ uint32_t CheckAgainstDestinations(const CheckContext& ctx, const InstanceReferen
                          DescribeOrigin(c.build), Hex(c.dst), Referencing(r, s), other.element));
       ++findings;
     }
-    if (!span || other.accessed.memory == VK_NULL_HANDLE) {
+    // An indirect command's: known when the device's counts were the recorded maxima (ExecutedAccess).
+    const MemorySpan accessed = ExecutedAccess(log, other);
+    if (!span || accessed.memory == VK_NULL_HANDLE) {
       CountUnknownState(ctx);
       continue;
     }
-    if (!Overlaps(*span, other.accessed)) continue;
-    const VkDeviceSize from = std::max(span->begin, other.accessed.begin);
-    const VkDeviceSize to = std::min(span->end, other.accessed.end);
+    if (!Overlaps(*span, accessed)) continue;
+    const VkDeviceSize from = std::max(span->begin, accessed.begin);
+    const VkDeviceSize to = std::min(span->end, accessed.end);
     Report(ctx, c, "dstAccelerationStructure-03706", s.handle,
            fmt::format("{}: builds top-level {}; on execution, {}, whose memory overlaps the bytes this command writes "
                        "for pInfos[{}].dstAccelerationStructure (VkAccelerationStructureKHR {}): {} bytes at "
                        "[0x{:x}, 0x{:x}) of VkDeviceMemory {}.",
                        DescribeOrigin(c.build), Hex(c.dst), Referencing(r, s), other.element, Hex(other.handle),
-                       to - from, from, to, Hex(other.accessed.memory)));
+                       to - from, from, to, Hex(accessed.memory)));
     ++findings;
   }
   return findings;

@@ -94,4 +94,21 @@ bool ExecutedGeometry(const CaptureLog& log, const CapturedInfo& info, uint32_t 
   return true;
 }
 
+MemorySpan ExecutedAccess(const CaptureLog& log, const CommandDestination& d) {
+  if (!d.indirect || d.accessed.memory == VK_NULL_HANDLE) return d.accessed;
+  if (d.counts_info == CommandDestination::kNoCountsInfo) return MemorySpan{};
+  const CapturedInfo* info = log.Readable(d.counts_info);
+  if (!info || !info->indirect || !info->ranges.present ||
+      info->first_geometry + info->geometry_count > log.max_primitive_counts.size()) {
+    return MemorySpan{};
+  }
+  for (uint32_t j = 0; j < info->geometry_count; ++j) {
+    VkAccelerationStructureBuildRangeInfoKHR range;
+    std::memcpy(&range, log.Bytes(info->ranges) + static_cast<std::size_t>(j) * info->indirect_stride,
+                sizeof(range));
+    if (range.primitiveCount != log.max_primitive_counts[info->first_geometry + j]) return MemorySpan{};
+  }
+  return d.accessed;
+}
+
 }  // namespace asval

@@ -188,6 +188,12 @@ struct CommandDestination {
   uint32_t element = 0;         // its index in pInfos
   VkDeviceAddress address = 0;  // 0: unknown
   MemorySpan accessed;          // the bytes this build writes (accelerationStructureSize); memory null: unknown
+  // Indirect commands: `accessed` is the size for ppMaxPrimitiveCounts, the bytes the build writes only when the
+  // range infos the device read hold those very counts; they are in CaptureLog::infos[counts_info] (kNoInfo: this
+  // info has no geometry, or its range infos were not captured, and `accessed` is then known or unknown as is).
+  bool indirect = false;
+  uint32_t counts_info = kNoCountsInfo;
+  static constexpr uint32_t kNoCountsInfo = UINT32_MAX;
 };
 
 // Whether the layer's dispatch reads the record an instance pointer names (shaders/reduce_inputs.comp decides the
@@ -232,6 +238,11 @@ class CaptureLog;
 // logged. False when the count is above ppMaxPrimitiveCounts (the dispatch read no more than the maximum: what the
 // build read is unknown; the count's own rule reports it) or the range infos were not captured.
 bool ExecutedGeometry(const CaptureLog& log, const CapturedInfo& info, uint32_t j, CapturedGeometry* out);
+
+// The bytes destination d of a command writes, as the device executed it: `accessed`, except for an indirect
+// command whose range infos for d hold other counts than ppMaxPrimitiveCounts (or were not captured): unknown
+// (memory null).
+MemorySpan ExecutedAccess(const CaptureLog& log, const CommandDestination& d);
 
 class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
  public:

@@ -244,11 +244,13 @@ TEST_CASE("hostile: a null ppBuildRangeInfos, or a null entry in it, with infoCo
   }
   SECTION("vkCmdBuildAccelerationStructuresKHR, ppBuildRangeInfos[0] null") {
     f.monitor().Expect(kScratchAlignment.direct);
+    f.monitor().Expect("VUID-vkCmdBuildAccelerationStructuresKHR-ppBuildRangeInfos-03676");  // the null entry itself
     Record(device, [&](VkCommandBuffer cb) { device.CmdBuildAccelerationStructuresKHR(cb, 1, &t.info, &null_entry); });
   }
   SECTION("vkBuildAccelerationStructuresKHR, ppBuildRangeInfos null and ppBuildRangeInfos[0] null") {
     auto host = Load<PFN_vkBuildAccelerationStructuresKHR>(device, "vkBuildAccelerationStructuresKHR");
     f.monitor().Expect(kFeature.host, 2);
+    f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-ppBuildRangeInfos-03676");  // the null entry
     CHECK(host(device.handle(), VK_NULL_HANDLE, 1, &t.info, nullptr) == VK_ERROR_VALIDATION_FAILED_EXT);
     CHECK(host(device.handle(), VK_NULL_HANDLE, 1, &t.info, &null_entry) == VK_ERROR_VALIDATION_FAILED_EXT);
   }

@@ -150,9 +150,9 @@ class IndirectTlas {
   }
   Tlas& tlas() { return tlas_; }
 
-  // One indirect command of two infos: pInfos[0] builds `blas` (one triangle), pInfos[1] the top level over `count`
-  // of the instances.
-  void BuildTogether(const Blas& blas, const vkkit::Buffer& instances, uint32_t count) {
+  // One indirect command of two infos: pInfos[0] builds `blas` (one triangle, of at most `bottom_max`), pInfos[1]
+  // the top level over `count` of the instances.
+  void BuildTogether(const Blas& blas, const vkkit::Buffer& instances, uint32_t count, uint32_t bottom_max = 1) {
     const VkAccelerationStructureBuildRangeInfoKHR ranges[2] = {{1, 0, 0, 0}, {count, 0, 0, 0}};
     std::memcpy(ranges_.mapped, ranges, sizeof(ranges));
     const BuildInfo bottom = blas.Info(Shape{});
@@ -160,7 +160,7 @@ class IndirectTlas {
     const VkAccelerationStructureBuildGeometryInfoKHR infos[2] = {bottom.info, top.info};
     const VkDeviceAddress addresses[2] = {ranges_.address, ranges_.address + sizeof(ranges[0])};
     const uint32_t strides[2] = {sizeof(ranges[0]), sizeof(ranges[0])};
-    const uint32_t bottom_max = 1, top_max = 4;
+    const uint32_t top_max = 4;
     const uint32_t* counts[2] = {&bottom_max, &top_max};
     SubmitAndWait(device_, RecordWith(commands_, [&](VkCommandBuffer cb) {
                     indirect_(cb, 2, infos, addresses, strides, counts);
