@@ -1,6 +1,7 @@
 // The test driver's entry points: the loader's layer interface, instance and device creation (the features it
 // adds are reported to the layers above and taken out of what reaches the driver below), and the commands it
 // executes itself. Everything else goes down the chain unchanged.
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -57,6 +58,28 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceMemoryProperties2(VkPhysicalDevice g
   AddMemoryType(&properties->memoryProperties);
 }
 
+// ASVAL_TEST_DRIVER_DEVICE_TYPE=integrated-gpu: the device says it is an integrated GPU instead of lavapipe's CPU, so
+// that what a layer does only on GPUs (asval's capture dispatch where it copies: docs/capture.md) runs through the
+// loader too. Read when asked (a test sets it around its instance).
+void ReportDeviceType(VkPhysicalDeviceProperties* properties) {
+  const char* type = std::getenv("ASVAL_TEST_DRIVER_DEVICE_TYPE");
+  if (type && std::strcmp(type, "integrated-gpu") == 0) {
+    properties->deviceType = VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU;
+  }
+}
+
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties(VkPhysicalDevice gpu, VkPhysicalDeviceProperties* properties) {
+  InstanceOf(gpu)->GetPhysicalDeviceProperties(gpu, properties);
+  ReportDeviceType(properties);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2(VkPhysicalDevice gpu, VkPhysicalDeviceProperties2* properties) {
+  InstanceData* instance = InstanceOf(gpu);
+  (instance->GetPhysicalDeviceProperties2 ? instance->GetPhysicalDeviceProperties2
+                                          : instance->GetPhysicalDeviceProperties2KHR)(gpu, properties);
+  ReportDeviceType(&properties->properties);
+}
+
 VKAPI_ATTR VkResult VKAPI_CALL EnumeratePhysicalDevices(VkInstance handle, uint32_t* count, VkPhysicalDevice* gpus) {
   InstanceData* instance = FindInstance(handle);
   const VkResult result = instance->EnumeratePhysicalDevices(handle, count, gpus);
@@ -89,6 +112,9 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* info, 
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties);
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties2);
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceMemoryProperties2KHR);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceProperties);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceProperties2);
+  ASVAL_DRIVER_LOAD(GetPhysicalDeviceProperties2KHR);
   ASVAL_DRIVER_LOAD(CreateDevice);
 #undef ASVAL_DRIVER_LOAD
   return VK_SUCCESS;
@@ -408,6 +434,11 @@ PFN_vkVoidFunction InstanceFunction(const char* name) {
   ASVAL_DRIVER_HOOK(GetPhysicalDeviceMemoryProperties2)
   if (std::strcmp(name, "vkGetPhysicalDeviceMemoryProperties2KHR") == 0) {
     return reinterpret_cast<PFN_vkVoidFunction>(&GetPhysicalDeviceMemoryProperties2);
+  }
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceProperties)
+  ASVAL_DRIVER_HOOK(GetPhysicalDeviceProperties2)
+  if (std::strcmp(name, "vkGetPhysicalDeviceProperties2KHR") == 0) {
+    return reinterpret_cast<PFN_vkVoidFunction>(&GetPhysicalDeviceProperties2);
   }
   ASVAL_DRIVER_HOOK(CreateDevice)
 #undef ASVAL_DRIVER_HOOK

@@ -1,6 +1,7 @@
 // The test driver through the real loader, alone over lavapipe: what it reports, and that what it executes is what
 // the device executes for the same inputs (a host build and its device twin serialize to the same bytes).
 #include <catch2/catch_test_macros.hpp>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -304,6 +305,28 @@ TEST_CASE("test driver: an indirect build reads its ranges from memory when its 
   d.device.Destroy(scratch);
   d.device.Destroy(indices);
   d.device.Destroy(vertices);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_CASE("test driver: says it is an integrated GPU when ASVAL_TEST_DRIVER_DEVICE_TYPE asks, lavapipe's CPU else") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  const auto type = [&] {
+    VkPhysicalDeviceProperties core{};
+    vkGetPhysicalDeviceProperties(gpu, &core);
+    VkPhysicalDeviceProperties2 both{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    vkGetPhysicalDeviceProperties2(gpu, &both);
+    CHECK(core.deviceType == both.properties.deviceType);
+    return core.deviceType;
+  };
+  unsetenv("ASVAL_TEST_DRIVER_DEVICE_TYPE");
+  CHECK(type() == VK_PHYSICAL_DEVICE_TYPE_CPU);
+  setenv("ASVAL_TEST_DRIVER_DEVICE_TYPE", "integrated-gpu", 1);
+  CHECK(type() == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU);
+  unsetenv("ASVAL_TEST_DRIVER_DEVICE_TYPE");
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "history_helpers.h"
 #include "indirect_helpers.h"
 #include "on_test_driver.h"
+#include "scoped_env.h"
 
 namespace asval_test {
 namespace {
@@ -365,6 +366,21 @@ TEST_CASE(
   gone.DestroyHandle();
   top.Build(pointed.pointers, 2, true);
   CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "capture on the test driver: where the capture copies on a GPU, an indirect update's geometry is read by the "
+    "layer's dispatch (pInfos-03664)",
+    "[integration][capture][test-driver][03664]") {
+  const OnTestDriver driver;
+  // The test driver says it is a GPU: asval's capture then copies the direct builds' inputs (capture_method=copy)
+  // and still reads what the indirect builds' range infos select with its dispatch.
+  const ScopedEnvironment gpu("ASVAL_TEST_DRIVER_DEVICE_TYPE", "integrated-gpu");
+  HistoryFixture f(nullptr, {{"capture_method", "copy"}}, IndirectBuild());
+  IndirectRig rig(f.device());
+  rig.Build(Triangles());
+  REQUIRE(f.monitor().Verify() == "");
+  CHECK(Probe(rig, f.monitor(), Triangles()) == "");
 }
 
 TEST_CASE(
