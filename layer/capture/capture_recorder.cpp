@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <utility>
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
@@ -76,62 +77,39 @@ struct CommandCounts {
 // its other destinations (None-03407, dstAccelerationStructure-03706), judged once the instances are captured.
 // The bytes each build writes are its accelerationStructureSize, as the size cache holds it: the command's
 // validation has just looked it up (or asked the driver). A size or memory not known leaves the span unknown.
+// counts_of(i): pInfos[i]'s primitive counts and the bytes from one to the next (null: not given). An indirect
+// command's are its ppMaxPrimitiveCounts: the bytes it writes for them are the bytes it writes when the range infos
+// the device reads hold those very counts (judged at completion: ExecutedAccess, capture_log.h).
+template <typename CountsOf>
 void ResolveDestinations(const DeviceState& state, uint32_t info_count,
-                         const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
+                         const VkAccelerationStructureBuildGeometryInfoKHR* infos, bool indirect, CountsOf counts_of,
                          std::vector<CommandDestination>& out) {
   out.assign(info_count, CommandDestination{});
   for (uint32_t i = 0; i < info_count; ++i) {
     CommandDestination& d = out[i];
     d.handle = infos[i].dstAccelerationStructure;
     d.element = i;
+    d.indirect = indirect;
     const std::optional<StructureMemory> memory = MemoryOfStructure(state, d.handle);
     if (!memory) continue;
     d.address = memory->structure->device_address;
-    BuildSignature signature;
-    signature.info = &infos[i];
-    BuildSizes sizes;
-    if (!ranges[i] && infos[i].geometryCount != 0) continue;
-    if (!GeometryCountWithinLimit(infos[i], state.properties.acceleration_structure.maxGeometryCount)) continue;
-    signature.counts = ranges[i] ? &ranges[i][0].primitiveCount : nullptr;
-    signature.count_stride = sizeof(VkAccelerationStructureBuildRangeInfoKHR);
-    if (infos[i].geometryCount != 0 && !state.build_sizes.Find(signature, &sizes)) continue;
-    if (std::optional<MemorySpan> span = memory->Span(sizes.acceleration_structure_size)) d.accessed = *span;
-  }
-}
-
-// The destinations of an indirect build command of several infos: their addresses (None-03407) and the bytes each
-// build writes for ppMaxPrimitiveCounts (the size cache holds them: the command's validation looked them up), which
-// are the bytes it writes when the device's range infos hold those counts (judged at completion, ExecutedAccess:
-// dstAccelerationStructure-03706); `captured` (per info, its log index plus one) names where those range infos are.
-void ResolveIndirectDestinations(const DeviceState& state, uint32_t info_count,
-                                 const VkAccelerationStructureBuildGeometryInfoKHR* infos,
-                                 const uint32_t* const* max_counts, std::vector<CommandDestination>& out) {
-  out.assign(info_count, CommandDestination{});
-  for (uint32_t i = 0; i < info_count; ++i) {
-    CommandDestination& d = out[i];
-    d.handle = infos[i].dstAccelerationStructure;
-    d.element = i;
-    d.indirect = true;
-    const std::optional<StructureMemory> memory = MemoryOfStructure(state, d.handle);
-    if (!memory) continue;
-    d.address = memory->structure->device_address;
-    if (infos[i].geometryCount != 0 && !max_counts[i]) continue;
+    const auto [counts, stride] = counts_of(i);
+    if (!counts && infos[i].geometryCount != 0) continue;
     if (!GeometryCountWithinLimit(infos[i], state.properties.acceleration_structure.maxGeometryCount)) continue;
     BuildSignature signature;
     signature.info = &infos[i];
-    signature.counts = max_counts[i];
-    signature.count_stride = sizeof(uint32_t);
+    signature.counts = counts;
+    signature.count_stride = stride;
     BuildSizes sizes;
     if (infos[i].geometryCount != 0 && !state.build_sizes.Find(signature, &sizes)) continue;
     if (std::optional<MemorySpan> span = memory->Span(sizes.acceleration_structure_size)) d.accessed = *span;
   }
 }
 
-// Where each destination's range infos were logged (ResolveIndirectDestinations): infos [0, through) of the command
-// so far, `captured` holding each one's log index plus one (0: not logged).
-void NoteCountsInfos(CaptureLog& log, uint32_t first_destination, uint32_t through, const std::vector<uint32_t>& captured,
-                     const VkAccelerationStructureBuildGeometryInfoKHR* infos) {
+// Where each destination's range infos were logged (ResolveDestinations of an indirect command): infos [0, through)
+// of the command so far, `captured` holding each one's log index plus one (0: not logged).
+void NoteCountsInfos(CaptureLog& log, uint32_t first_destination, uint32_t through,
+                     const std::vector<uint32_t>& captured, const VkAccelerationStructureBuildGeometryInfoKHR* infos) {
   for (uint32_t k = 0; k < through && k < captured.size(); ++k) {
     CommandDestination& d = log.destinations[first_destination + k];
     if (captured[k] != 0) {
@@ -308,7 +286,10 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
           geometry_bytes = 0;
         } else if (info_count > 1 && infos[i].type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
           if (!destinations_logged) {  // once per command, shared by its top-level infos
-            ResolveIndirectDestinations(ctx.state, info_count, infos, max_primitive_counts, destinations);
+            ResolveDestinations(
+                ctx.state, info_count, infos, true,
+                [&](uint32_t k) { return std::make_pair(max_primitive_counts[k], uint32_t{sizeof(uint32_t)}); },
+                destinations);
             first_destination = log.AddDestinations(destinations.data(), info_count);
             destinations_logged = true;
           }
@@ -376,7 +357,12 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, CommandBufferState& re
     entry.element = i;
     if (info_count > 1 && info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR) {
       if (!destinations_logged) {  // once per command, shared by its top-level infos
-        ResolveDestinations(ctx.state, info_count, infos, ranges, destinations);
+        ResolveDestinations(ctx.state, info_count, infos, false,
+                            [&](uint32_t k) {  // primitiveCount is a range info's first member
+                              return std::make_pair(ranges[k] ? &ranges[k][0].primitiveCount : nullptr,
+                                                    uint32_t{sizeof(VkAccelerationStructureBuildRangeInfoKHR)});
+                            },
+                            destinations);
         first_destination = log.AddDestinations(destinations.data(), info_count);
         destinations_logged = true;
       }

@@ -11,12 +11,10 @@
 
 namespace {
 
-using asval_test::Blas;
 using asval_test::Component;
 using asval_test::IndirectRig;
-using asval_test::IndirectTlas;
 using asval_test::kNan;
-using asval_test::Shape;
+using asval_test::TopLevelRig;
 using asval_test::Triangles;
 using asval_test::Vertices;
 
@@ -52,18 +50,21 @@ CORPUS_CASE_ON_TEST_DRIVER(IndirectRefitKeepsActivity, "history-indirect-refit-k
   for (float dx : {0.25f, 0.5f, 0.75f}) IndirectUpdate(rig, false, dx);
 }
 
+// An indirect TLAS build over instances of a live BLAS and of one whose handle was destroyed, `count` of them read
+// (the range info's count; the recorded maximum is 4).
+void BuildOverDestroyedBlas(vkkit::Device& device, uint32_t count) {
+  TopLevelRig made(device);
+  auto& [rig, gone, top] = made;
+  vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &gone});
+  gone.DestroyHandle();
+  top.Build(instances, count);
+  device.Destroy(instances);
+}
+
 CORPUS_CASE_ON_TEST_DRIVER(IndirectTlasDestroyedBlas, "history-indirect-tlas-instance-of-destroyed-blas", "history",
                            kIndirect, "an indirect TLAS build whose range info selects an instance of a destroyed BLAS",
                            {"VUID-vkCmdBuildAccelerationStructuresIndirectKHR-pInfos-12281"}) {
-  IndirectRig rig(device);
-  rig.Build(Triangles());
-  Blas gone(device, rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
-  IndirectTlas top(device);
-  vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &gone});
-  gone.DestroyHandle();
-  top.Build(instances, 2);
-  device.Destroy(instances);
+  BuildOverDestroyedBlas(device, 2);
 }
 
 CORPUS_CASE_ON_TEST_DRIVER(IndirectTlasReadsRangeCount, "history-indirect-tlas-reads-only-the-range-count", "history",
@@ -71,15 +72,7 @@ CORPUS_CASE_ON_TEST_DRIVER(IndirectTlasReadsRangeCount, "history-indirect-tlas-r
                            "an indirect TLAS build of one instance (its range info's count) from a buffer whose next "
                            "instance names a destroyed BLAS",
                            {}) {
-  IndirectRig rig(device);
-  rig.Build(Triangles());
-  Blas gone(device, rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
-  IndirectTlas top(device);
-  vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &gone});
-  gone.DestroyHandle();
-  top.Build(instances, 1);
-  device.Destroy(instances);
+  BuildOverDestroyedBlas(device, 1);
 }
 
 }  // namespace

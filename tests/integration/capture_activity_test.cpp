@@ -24,32 +24,11 @@ constexpr const char* kBecameActive = "VUID-vkCmdBuildAccelerationStructuresKHR-
 constexpr const char* kBecameInactive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664";
 constexpr const char* kIndicesChanged = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03768";
 
-constexpr uint32_t kNan = 0x7fc00000u;       // the quiet NaN
 constexpr uint32_t kOtherNan = 0xffc00001u;  // a NaN with another sign and payload
-constexpr VkDeviceSize kVertexBytes = 12;    // R32G32B32_SFLOAT, tightly packed (the helpers' vertexStride)
 constexpr VkDeviceSize kAabbBytes = 24;
 
-uint32_t Bits(float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
-
-// Where component c (0: X) of vertex v, and minX of AABB a, lie in the inputs buffer.
-VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + kVertexBytes * v + 4 * c; }
+// Where minX of AABB a lies in the inputs buffer (capture_helpers.h: Component, the vertices' components).
 VkDeviceSize MinX(uint32_t a) { return Inputs::kAabbsOffset + kAabbBytes * a; }
-
-// Six vertices: triangles (0, 1, 2) and (3, 4, 5), unit right triangles at z = 0 and z = 1, moved by dx along X.
-std::vector<uint32_t> Vertices(float dx = 0) {
-  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-  std::vector<uint32_t> words;
-  for (uint32_t v = 0; v < 6; ++v) {
-    words.push_back(Bits(corner[v % 3][0] + dx));
-    words.push_back(Bits(corner[v % 3][1]));
-    words.push_back(Bits(static_cast<float>(v / 3)));
-  }
-  return words;
-}
 
 // Two unit boxes side by side, moved by dx along X.
 std::vector<uint32_t> Boxes(float dx = 0) {

@@ -26,7 +26,6 @@ namespace {
 
 constexpr const char* kBecameActive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03663";
 constexpr VkBufferUsageFlags kInputUsage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-constexpr uint32_t kNan = 0x7fc00000u;
 constexpr uint32_t kVertexOffset = 1024;  // where a test's vertices lie in its memory
 
 using ScopedEnv = ScopedEnvironment;  // scoped_env.h

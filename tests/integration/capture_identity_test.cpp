@@ -29,15 +29,6 @@ constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKH
 constexpr uint32_t kSlots = 8;  // structures relocated at once: each had even odds of being taken for its old handle
 constexpr VkDeviceSize kOwnStorageBytes = 1 << 20;  // more than lavapipe's size for any Shape
 
-VkAccelerationStructureInstanceKHR Instance(VkDeviceAddress reference, uint32_t i) {
-  VkAccelerationStructureInstanceKHR instance{};
-  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
-  instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f;
-  instance.mask = 0xff;
-  instance.accelerationStructureReference = reference;
-  return instance;
-}
-
 // The messages since the last check, one line each ("id: text"), for a failure's explanation.
 std::string Seen(Monitor& monitor) {
   std::string seen;
@@ -128,7 +119,7 @@ class Rig {
   // A top-level build (in a command buffer of its own) whose instances reference `references`, in this order.
   void BuildTopLevel(const std::vector<VkDeviceAddress>& references) {
     std::vector<VkAccelerationStructureInstanceKHR> instances;
-    for (uint32_t i = 0; i < references.size(); ++i) instances.push_back(Instance(references[i], i));
+    for (uint32_t i = 0; i < references.size(); ++i) instances.push_back(InstanceRecord(references[i], i));
     std::memcpy(instances_.mapped, instances.data(), instances.size() * kInstanceBytes);
     Run([&](VkCommandBuffer cb) {
       tlas_.Record(cb, instances_, static_cast<uint32_t>(references.size()), VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);

@@ -19,7 +19,6 @@ namespace asval_test {
 namespace {
 
 constexpr const char* kBecameInactive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664";
-constexpr uint32_t kNan = 0x7fc00000u;
 constexpr uint32_t kElements = 64;  // one workgroup of write_value.comp
 
 // The app's compute work: write_value.comp with its storage buffer bound in a descriptor set and its value pushed.

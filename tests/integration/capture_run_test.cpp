@@ -24,24 +24,6 @@ namespace asval_test {
 namespace {
 
 constexpr const char* kBecameInactive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664";
-constexpr uint32_t kNan = 0x7fc00000u;
-constexpr VkDeviceSize kVertexBytes = 12;  // R32G32B32_SFLOAT, tightly packed
-
-VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + kVertexBytes * v + 4 * c; }
-
-// Triangles (0, 1, 2) and (3, 4, 5): unit right triangles at z = 0 and z = 1.
-std::vector<uint32_t> Vertices() {
-  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-  std::vector<uint32_t> words;
-  for (uint32_t v = 0; v < 6; ++v) {
-    for (float value : {corner[v % 3][0], corner[v % 3][1], static_cast<float>(v / 3)}) {
-      uint32_t bits;
-      std::memcpy(&bits, &value, sizeof(bits));
-      words.push_back(bits);
-    }
-  }
-  return words;
-}
 
 Shape Triangles() {
   Shape s;

@@ -29,15 +29,6 @@ constexpr const char* kStorageNotBound = "VUID-vkCmdBuildAccelerationStructuresK
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);  // 64
 constexpr uint32_t kMaxInstances = 4;  // the helpers' Tlas is sized for 4
 
-VkAccelerationStructureInstanceKHR Instance(VkDeviceAddress reference, uint32_t i) {
-  VkAccelerationStructureInstanceKHR instance{};
-  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
-  instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f;
-  instance.mask = 0xff;
-  instance.accelerationStructureReference = reference;
-  return instance;
-}
-
 // Bottom-level structures `a` and `b` (own storage each), `overlap` created in b's storage 256 bytes in (its
 // bytes overlap b's, at another address), a top-level structure and its instance buffer. a and b are built validly at the start.
 class Rig {
@@ -71,7 +62,7 @@ class Rig {
   void BuildTogether(const std::vector<const Blas*>& blases, const std::vector<VkDeviceAddress>& references) {
     Run([&](VkCommandBuffer cb) {
       std::vector<VkAccelerationStructureInstanceKHR> instances;
-      for (uint32_t i = 0; i < references.size(); ++i) instances.push_back(Instance(references[i], i));
+      for (uint32_t i = 0; i < references.size(); ++i) instances.push_back(InstanceRecord(references[i], i));
       vkCmdUpdateBuffer(cb, instances_.buffer, 0, instances.size() * kInstanceBytes, instances.data());
       InputsWritten(cb);
       std::vector<BuildInfo> infos;

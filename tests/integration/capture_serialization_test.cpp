@@ -18,7 +18,6 @@ namespace {
 
 constexpr const char* kPrimitiveCount = "VUID-vkCmdBuildAccelerationStructuresKHR-primitiveCount-03769";
 constexpr const char* kBecameInactive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664";
-constexpr uint32_t kNan = 0x7fc00000u;
 
 // One triangle, with maxVertex room for two: an update to two triangles then changes only primitiveCount.
 Shape OneTriangle() {

@@ -20,15 +20,8 @@ namespace {
 constexpr const char* kFloatSpacing = "ASVAL-Capture-FloatSpacing";
 constexpr const char* kDegenerateInstance = "ASVAL-Capture-DegenerateInstance";
 constexpr const char* kUndefinedInput = "ASVAL-Capture-UndefinedInput";
-constexpr uint32_t kNan = 0x7fc00000u;
 constexpr const char* kAllButSpacing = "undefined_input,non_finite_transform,degenerate_instance";
 constexpr const char* kAll = "undefined_input,non_finite_transform,float_spacing,degenerate_instance";
-
-uint32_t Bits(float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
 
 // Two unit right triangles (R32G32B32_SFLOAT, the helpers' layout), the first at x = x0, the second at x = x1.
 std::vector<uint32_t> TwoTriangles(float x0, float x1) {

@@ -31,7 +31,6 @@ namespace {
 
 constexpr const char* kBecameInactive = "VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664";
 constexpr const char* kSummaryId = "ASVAL-History-Summary";
-constexpr uint32_t kNan = 0x7fc00000u;
 
 // What one run of the program saw.
 struct Outcome {

@@ -329,15 +329,20 @@ Tlas::~Tlas() {
   device_.Destroy(scratch_);
 }
 
+VkAccelerationStructureInstanceKHR InstanceRecord(VkDeviceAddress reference, uint32_t i) {
+  VkAccelerationStructureInstanceKHR instance{};
+  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
+  instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f;
+  instance.mask = 0xff;
+  instance.accelerationStructureReference = reference;
+  return instance;
+}
+
 vkkit::Buffer Tlas::MakeInstances(const std::vector<const Blas*>& blases) {
   const size_t count = std::max<size_t>(1, blases.size());
   vkkit::Buffer buffer = device_.CreateBuffer(sizeof(VkAccelerationStructureInstanceKHR) * count, kInputUsage);
   for (size_t i = 0; i < blases.size(); ++i) {
-    VkAccelerationStructureInstanceKHR instance{};
-    instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
-    instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f;
-    instance.mask = 0xff;
-    instance.accelerationStructureReference = blases[i]->address();
+    const VkAccelerationStructureInstanceKHR instance = InstanceRecord(blases[i]->address(), static_cast<uint32_t>(i));
     std::memcpy(static_cast<unsigned char*>(buffer.mapped) + i * sizeof(instance), &instance, sizeof(instance));
   }
   return buffer;

@@ -178,6 +178,9 @@ class Blas {
   VkDeviceAddress address_ = 0;
 };
 
+// An instance of `reference` (0: inactive), an identity transform moved 4 units along X per index `i`, mask 0xff.
+VkAccelerationStructureInstanceKHR InstanceRecord(VkDeviceAddress reference, uint32_t i);
+
 // A top-level structure over up to `max_instances` instances of bottom-level structures, read from an instance
 // buffer that the caller may replace every frame.
 class Tlas {

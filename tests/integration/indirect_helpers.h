@@ -15,30 +15,6 @@
 
 namespace asval_test {
 
-inline constexpr uint32_t kNan = 0x7fc00000u;     // the quiet NaN
-inline constexpr VkDeviceSize kVertexBytes = 12;  // R32G32B32_SFLOAT, tightly packed (the helpers' vertexStride)
-
-inline uint32_t Bits(float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, sizeof(bits));
-  return bits;
-}
-
-// Where component c (0: X) of vertex v lies in the inputs buffer.
-inline VkDeviceSize Component(uint32_t v, uint32_t c) { return Inputs::kVerticesOffset + kVertexBytes * v + 4 * c; }
-
-// Six vertices: triangles (0, 1, 2) and (3, 4, 5), unit right triangles at z = 0 and z = 1, moved by dx along X.
-inline std::vector<uint32_t> Vertices(float dx = 0) {
-  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-  std::vector<uint32_t> words;
-  for (uint32_t v = 0; v < 6; ++v) {
-    words.push_back(Bits(corner[v % 3][0] + dx));
-    words.push_back(Bits(corner[v % 3][1]));
-    words.push_back(Bits(static_cast<float>(v / 3)));
-  }
-  return words;
-}
-
 inline Shape Triangles(uint32_t count = 2) {
   Shape s;
   s.triangles = count;
@@ -173,6 +149,19 @@ class IndirectTlas {
   Commands commands_;
   vkkit::Buffer ranges_;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR indirect_;
+};
+
+// What the top-level tests start from: `rig`'s structure built indirectly, `other` over the same inputs built
+// directly, and a top-level structure for indirect builds over instances of them
+// (`auto& [rig, other, top] = TopLevelRig(device)`).
+struct TopLevelRig {
+  explicit TopLevelRig(vkkit::Device& device) : rig(device), other(device, rig.inputs()), top(device) {
+    rig.Build(Triangles());
+    rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
+  }
+  IndirectRig rig;
+  Blas other;
+  IndirectTlas top;
 };
 
 }  // namespace asval_test

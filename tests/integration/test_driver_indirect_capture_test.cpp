@@ -173,11 +173,8 @@ TEST_CASE(
     "[integration][capture][test-driver][12281][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas gone(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, gone, top] = made;
   vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &gone});
   gone.DestroyHandle();
   top.Build(instances, 2);
@@ -191,11 +188,8 @@ TEST_CASE(
     "[integration][capture][test-driver][03709][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas lost(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { lost.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, lost, top] = made;
   vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &lost});
   lost.DestroyStorageBuffer();  // the structure and its memory stay (the driver still reads the bytes there)
   top.Build(instances, 2);
@@ -209,11 +203,8 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas gone(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, gone, top] = made;
   vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &gone});
   top.Build(instances, 2);
   CHECK(f.monitor().Verify() == "");
@@ -230,11 +221,8 @@ TEST_CASE(
     "[integration][capture][test-driver][03407][03706][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas other(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, other, top] = made;
   vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &other});
   top.BuildTogether(other, instances, 2);  // pInfos[0] builds `other` again; instance 1 references it
   // Its address is another destination's (03407), and its memory the bytes pInfos[0] writes (03706: the range info's
@@ -255,12 +243,9 @@ TEST_CASE(
     "[integration][capture][test-driver][03706][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas other(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
+  TopLevelRig made(f.device());
+  auto& [rig, other, top] = made;
   Blas over(rig.device(), rig.inputs(), &other, 256);  // in other's storage, 256 bytes in
-  IndirectTlas top(rig.device());
   vkkit::Buffer instances = top.tlas().MakeInstances({&other});
   top.BuildTogether(over, instances, 1);  // pInfos[0] builds `over`, its count the recorded maximum
   CHECK(OnlyFinding(f.monitor(), kReferencedOverlap, "geometry 0, instance 0 references") == "");
@@ -273,12 +258,9 @@ TEST_CASE(
     "[integration][capture][test-driver][03706][passes-invalid-down]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas other(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
+  TopLevelRig made(f.device());
+  auto& [rig, other, top] = made;
   Blas over(rig.device(), rig.inputs(), &other, 256);
-  IndirectTlas top(rig.device());
   vkkit::Buffer instances = top.tlas().MakeInstances({&other});
   top.BuildTogether(over, instances, 1, 2);  // pInfos[0]: one triangle of at most two
   CHECK(f.monitor().Verify() == "");
@@ -291,11 +273,8 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas other(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { other.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, other, top] = made;
   vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &other});
   top.BuildTogether(other, instances, 1);  // only instance 0 (rig's structure) is read
   CHECK(f.monitor().Verify() == "");
@@ -314,11 +293,8 @@ struct PointedRecords {
     std::memset(records.mapped, 0, 1024);
     std::memset(pointers.mapped, 0, sizeof(VkDeviceAddress) * 4);
     for (size_t i = 0; i < blases.size(); ++i) {
-      VkAccelerationStructureInstanceKHR instance{};
-      instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
-      instance.transform.matrix[0][3] = static_cast<float>(i) * 4.0f;
-      instance.mask = 0xff;
-      instance.accelerationStructureReference = blases[i]->address();
+      const VkAccelerationStructureInstanceKHR instance =
+          InstanceRecord(blases[i]->address(), static_cast<uint32_t>(i));
       std::memcpy(static_cast<unsigned char*>(records.mapped) + offsets[i], &instance, sizeof(instance));
       const VkDeviceAddress pointer = records.address + offsets[i];
       std::memcpy(static_cast<unsigned char*>(pointers.mapped) + i * sizeof(pointer), &pointer, sizeof(pointer));
@@ -354,11 +330,8 @@ TEST_CASE(
     "[integration][capture][test-driver][valid]") {
   const OnTestDriver driver;
   HistoryFixture f(nullptr, Reduced(), IndirectBuild());
-  IndirectRig rig(f.device());
-  rig.Build(Triangles());
-  Blas gone(rig.device(), rig.inputs());
-  rig.Run([&](VkCommandBuffer cb) { gone.Build(cb, Shape{}); });
-  IndirectTlas top(rig.device());
+  TopLevelRig made(f.device());
+  auto& [rig, gone, top] = made;
   const PointedRecords pointed(rig.device(), {&rig.blas(), &rig.blas(), &gone}, {0, 128, 256 + 8});
   top.Build(pointed.pointers, 2, true);
   CHECK(f.monitor().Verify() == "");
