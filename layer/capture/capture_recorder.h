@@ -53,9 +53,11 @@ bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, std::vector<uint32_t>& captured);
 
-// vkCmdBuildAccelerationStructuresIndirectKHR: plans the copies of every info's range infos (read by the device
-// from pIndirectDeviceAddresses[i], pIndirectStrides[i] apart), keeping ppMaxPrimitiveCounts[i] with them, so that
-// the counts can be checked once the submission completes. `captured` as for CaptureBuildInputs.
+// vkCmdBuildAccelerationStructuresIndirectKHR (capture_indirect.cpp): plans the copies of every info's range infos
+// (read by the device from pIndirectDeviceAddresses[i], pIndirectStrides[i] apart), keeping ppMaxPrimitiveCounts[i]
+// with them, so that the counts can be checked once the submission completes; and, for the infos `capture` names,
+// where the pool dispatches (CaptureGathers), the second stage: the geometry those range infos select, read by the
+// layer's dispatch (docs/capture.md "Indirect builds"). `captured` as for CaptureBuildInputs.
 bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& recording,
                            uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkDeviceAddress* addresses, const uint32_t* strides,
