@@ -1,3 +1,7 @@
+// Pre-record of vkCmdBuildAccelerationStructuresIndirectKHR (capture_recorder.h, issue 28): the copies of each info's
+// range infos (the first stage), and for the infos `capture` names the jobs of the layer's dispatch that read the
+// geometry those range infos select (the second stage, docs/capture.md "Indirect builds"); the command's
+// destinations for the rules about its top-level infos' instances.
 #include <algorithm>
 #include <cstring>
 #include <new>

@@ -1,3 +1,4 @@
+// What the two build recorders share (capture_recording.h).
 #include "capture_recording.h"
 
 #include <algorithm>
