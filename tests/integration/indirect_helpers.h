@@ -112,10 +112,12 @@ class IndirectTlas {
 
   // Builds the top level over `count` of the instances (the range info's count; the recorded maximum is 4), given
   // as records or (`pointers`) as an array of pointers to them.
-  void Build(const vkkit::Buffer& instances, uint32_t count, bool pointers = false) {
+  // `mode` UPDATE: an update in place of the last build.
+  void Build(const vkkit::Buffer& instances, uint32_t count, bool pointers = false,
+             VkBuildAccelerationStructureModeKHR mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR) {
     const VkAccelerationStructureBuildRangeInfoKHR range{count, 0, 0, 0};
     std::memcpy(ranges_.mapped, &range, sizeof(range));
-    BuildInfo built = tlas_.Info(instances, 4, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    BuildInfo built = tlas_.Info(instances, 4, mode);
     built.geometries[0].geometry.instances.arrayOfPointers = pointers ? VK_TRUE : VK_FALSE;
     const uint32_t max_count = 4;
     const uint32_t* counts = &max_count;

@@ -141,6 +141,57 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("capture on the test driver: an indirect update that makes an AABB inactive is reported (pInfos-03664)",
+          "[integration][capture][test-driver][03664]") {
+  const OnTestDriver driver;
+  HistoryFixture f(nullptr, Reduced(), IndirectBuild());
+  IndirectRig rig(f.device());
+  Shape boxes = Triangles();
+  boxes.geometry_type = VK_GEOMETRY_TYPE_AABBS_KHR;
+  constexpr VkDeviceSize kAabbBytes = 24;
+  const auto write_boxes = [&](VkCommandBuffer cb, float dx) {  // two unit boxes side by side, moved by dx
+    std::vector<uint32_t> words;
+    for (float x : {0.0f, 2.0f}) {
+      for (float value : {x + dx, 0.0f, 0.0f, x + dx + 1, 1.0f, 1.0f}) words.push_back(Bits(value));
+    }
+    rig.Write(cb, Inputs::kAabbsOffset, words);
+  };
+  rig.SetRanges({IndirectRig::ShapeRange(boxes)});
+  rig.Run([&](VkCommandBuffer cb) {
+    write_boxes(cb, 0);
+    rig.Record(cb, boxes, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  });
+  rig.Run([&](VkCommandBuffer cb) {  // moved: silent
+    write_boxes(cb, 0.5f);
+    rig.Record(cb, boxes, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR);
+  });
+  REQUIRE(f.monitor().Verify() == "");
+  rig.Run([&](VkCommandBuffer cb) {
+    rig.Fill(cb, Inputs::kAabbsOffset + kAabbBytes, kNan);  // box 1's minX
+    rig.Record(cb, boxes, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR);
+  });
+  CHECK(OnlyFinding(f.monitor(), kBecameInactive, ": primitive 1") == "");
+}
+
+TEST_CASE(
+    "capture on the test driver: an indirect top-level update that makes an active instance inactive is "
+    "reported (pInfos-03664)",
+    "[integration][capture][test-driver][03664]") {
+  const OnTestDriver driver;
+  HistoryFixture f(nullptr, Reduced(), IndirectBuild());
+  TopLevelRig made(f.device());
+  auto& [rig, other, top] = made;
+  vkkit::Buffer instances = top.tlas().MakeInstances({&rig.blas(), &other});
+  top.Build(instances, 2);
+  top.Build(instances, 2, false, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR);  // the same instances: silent
+  REQUIRE(f.monitor().Verify() == "");
+  const VkAccelerationStructureInstanceKHR inactive = InstanceRecord(0, 1);  // instance 1 now references nothing
+  std::memcpy(static_cast<unsigned char*>(instances.mapped) + sizeof(inactive), &inactive, sizeof(inactive));
+  top.Build(instances, 2, false, VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR);
+  CHECK(OnlyFinding(f.monitor(), kBecameInactive, ": primitive 1") == "");
+  rig.device().Destroy(instances);
+}
+
 TEST_CASE(
     "capture on the test driver: an indirect build's primitives are counted from the range info's "
     "primitiveOffset and firstVertex the device read",
