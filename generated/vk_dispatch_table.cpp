@@ -79,6 +79,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateBuffer = reinterpret_cast<PFN_vkCreateBuffer>(gdpa(device, "vkCreateBuffer"));
   table->CreateCommandPool = reinterpret_cast<PFN_vkCreateCommandPool>(gdpa(device, "vkCreateCommandPool"));
   table->CreateComputePipelines = reinterpret_cast<PFN_vkCreateComputePipelines>(gdpa(device, "vkCreateComputePipelines"));
+  table->CreateEvent = reinterpret_cast<PFN_vkCreateEvent>(gdpa(device, "vkCreateEvent"));
   table->CreateFence = reinterpret_cast<PFN_vkCreateFence>(gdpa(device, "vkCreateFence"));
   table->CreatePipelineLayout = reinterpret_cast<PFN_vkCreatePipelineLayout>(gdpa(device, "vkCreatePipelineLayout"));
   table->CreateQueryPool = reinterpret_cast<PFN_vkCreateQueryPool>(gdpa(device, "vkCreateQueryPool"));
@@ -90,6 +91,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->DestroyCommandPool = reinterpret_cast<PFN_vkDestroyCommandPool>(gdpa(device, "vkDestroyCommandPool"));
   table->DestroyDeferredOperationKHR = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(gdpa(device, "vkDestroyDeferredOperationKHR"));
   table->DestroyDevice = reinterpret_cast<PFN_vkDestroyDevice>(gdpa(device, "vkDestroyDevice"));
+  table->DestroyEvent = reinterpret_cast<PFN_vkDestroyEvent>(gdpa(device, "vkDestroyEvent"));
   table->DestroyFence = reinterpret_cast<PFN_vkDestroyFence>(gdpa(device, "vkDestroyFence"));
   table->DestroyPipeline = reinterpret_cast<PFN_vkDestroyPipeline>(gdpa(device, "vkDestroyPipeline"));
   table->DestroyPipelineLayout = reinterpret_cast<PFN_vkDestroyPipelineLayout>(gdpa(device, "vkDestroyPipelineLayout"));

@@ -59,6 +59,7 @@ struct DeviceDispatchTable {
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
   PFN_vkCreateComputePipelines CreateComputePipelines = nullptr;
+  PFN_vkCreateEvent CreateEvent = nullptr;
   PFN_vkCreateFence CreateFence = nullptr;
   PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
@@ -70,6 +71,7 @@ struct DeviceDispatchTable {
   PFN_vkDestroyCommandPool DestroyCommandPool = nullptr;
   PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
   PFN_vkDestroyDevice DestroyDevice = nullptr;
+  PFN_vkDestroyEvent DestroyEvent = nullptr;
   PFN_vkDestroyFence DestroyFence = nullptr;
   PFN_vkDestroyPipeline DestroyPipeline = nullptr;
   PFN_vkDestroyPipelineLayout DestroyPipelineLayout = nullptr;

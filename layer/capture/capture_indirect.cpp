@@ -126,7 +126,8 @@ bool ReduceIndirectGeometries(const CaptureContext& ctx, CaptureRun& run, Captur
 
 }  // namespace
 
-bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& recording, uint32_t info_count,
+bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+                           uint32_t info_count,
                            const VkAccelerationStructureBuildGeometryInfoKHR* infos, const VkDeviceAddress* addresses,
                            const uint32_t* strides, const uint32_t* const* max_primitive_counts,
                            std::vector<uint32_t>& captured) {
@@ -212,7 +213,7 @@ bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& record
       NoteCountsInfos(recording.CaptureLogFor(ctx.pool.shared_from_this()), first_destination, info_count, captured,
                       infos);
     }
-    KeepOpen(ctx, run, copies_before);
+    KeepOpen(ctx, cb, recording, copies_before);
     counts.AddTo(ctx.counters);
     return !captured.empty();
   } catch (const std::bad_alloc&) {

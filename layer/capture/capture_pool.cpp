@@ -147,6 +147,38 @@ void CapturePool::Return(const CaptureSlab& slab) {
   free_.push_back(slab);
 }
 
+VkEvent CapturePool::TakeEvent() {
+  if (!next_.CreateEvent || !next_.DestroyEvent || !next_.CmdSetEvent || !next_.CmdWaitEvents ||
+      !next_.CmdResetEvent) {
+    return VK_NULL_HANDLE;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shut_down_) return VK_NULL_HANDLE;
+  if (!free_events_.empty()) {
+    const VkEvent event = free_events_.back();
+    free_events_.pop_back();
+    return event;
+  }
+  // Room in both lists first, as for slabs: ReturnEvent never allocates, and no event outlives the device.
+  try {
+    all_events_.reserve(all_events_.size() + 1);
+    free_events_.reserve(all_events_.size() + 1);
+  } catch (const std::bad_alloc&) {
+    return VK_NULL_HANDLE;
+  }
+  VkEventCreateInfo info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+  VkEvent event = VK_NULL_HANDLE;
+  if (next_.CreateEvent(device_, &info, nullptr, &event) != VK_SUCCESS) return VK_NULL_HANDLE;
+  all_events_.push_back(event);
+  return event;
+}
+
+void CapturePool::ReturnEvent(VkEvent event) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shut_down_ || free_events_.size() == free_events_.capacity()) return;  // destroyed at Shutdown
+  free_events_.push_back(event);
+}
+
 void CapturePool::Shutdown() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (shut_down_) return;
@@ -154,6 +186,9 @@ void CapturePool::Shutdown() {
   for (const CaptureSlab& slab : all_) Destroy(slab);
   all_.clear();
   free_.clear();
+  for (VkEvent event : all_events_) next_.DestroyEvent(device_, event, nullptr);
+  all_events_.clear();
+  free_events_.clear();
   reducer_.reset();  // its module and layout, before the device goes
 }
 

@@ -32,6 +32,10 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   // out of memory): the capture is then skipped and counted.
   bool Take(VkDeviceSize bytes, CaptureSlab* slab) override;
   void Return(const CaptureSlab& slab) override;
+  // The capture points' events (capture_run.h), made on demand and reused; null where the device has no event
+  // commands or the event cannot be made.
+  VkEvent TakeEvent() override;
+  void ReturnEvent(VkEvent event) override;
   // vkDestroyDevice: every slab is destroyed, also those still held by recordings (given back later: ignored).
   void Shutdown();
   // Adds its slabs to the layer's footprint (footprint.h).
@@ -59,6 +63,8 @@ class CapturePool : public CaptureSlabOwner, public std::enable_shared_from_this
   std::vector<CaptureSlab> free_;
   std::vector<CaptureSlab> all_;  // every live slab, for Shutdown
   std::size_t peak_in_use_ = 0;   // the most slabs taken at once (footprint)
+  std::vector<VkEvent> free_events_;
+  std::vector<VkEvent> all_events_;  // every event made, for Shutdown
   bool shut_down_ = false;
 };
 

@@ -44,7 +44,7 @@ namespace {
 
 // CaptureBuildInputs, but an allocation failure throws (nothing is recorded into cb here: the run's capture point
 // records the copies and the dispatch).
-bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, CommandBufferState& recording,
+bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                                uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                                const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                                std::vector<uint32_t>& captured) {
@@ -182,24 +182,24 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, CommandBufferState& re
     }
     captured[i] = log.AddInfo(entry, planned.data(), nullptr, total);
   }
-  KeepOpen(ctx, run, copies_before);
+  KeepOpen(ctx, cb, recording, copies_before);
   counts.AddTo(ctx.counters);
   return !captured.empty();
 }
 
 }  // namespace
 
-bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording,
+bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                         std::vector<uint32_t>& captured) {
   captured.clear();
   if (!infos || !ranges || !ctx.next.CmdCopyBuffer || !ctx.next.CmdPipelineBarrier) return false;
   try {
-    return CaptureBuildInputsOrThrow(ctx, recording, info_count, infos, ranges, captured);
+    return CaptureBuildInputsOrThrow(ctx, cb, recording, info_count, infos, ranges, captured);
   } catch (const std::bad_alloc&) {
     // What the run planned before the failure is still recorded at its capture point (nobody reads it).
-    KeepOpen(ctx, recording.capture_run, 1);
+    KeepOpen(ctx, cb, recording, 1);
     uint64_t needing = 0;
     for (uint32_t i = 0; i < info_count; ++i) needing += NeedsCapture(ctx.mode, infos[i]);
     return CaptureDropped(ctx, needing, captured);

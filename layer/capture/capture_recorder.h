@@ -49,7 +49,7 @@ inline bool NeedsCapture(CaptureMode mode, const VkAccelerationStructureBuildGeo
 // vkCmdBuildAccelerationStructuresKHR: plans the captures of the infos that need them into `recording`'s run and
 // writes, per info, its index in recording.capture_log->infos plus one, or 0, into
 // `captured` (resized to info_count). False when nothing was captured (captured is then left empty).
-bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording,
+bool CaptureBuildInputs(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                         uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                         const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, std::vector<uint32_t>& captured);
 
@@ -58,7 +58,7 @@ bool CaptureBuildInputs(const CaptureContext& ctx, CommandBufferState& recording
 // with them, so that the counts can be checked once the submission completes; and, for the infos `capture` names,
 // where the pool dispatches (CaptureGathers), the second stage: the geometry those range infos select, read by the
 // layer's dispatch (docs/capture.md "Indirect builds"). `captured` as for CaptureBuildInputs.
-bool CaptureIndirectRanges(const CaptureContext& ctx, CommandBufferState& recording,
+bool CaptureIndirectRanges(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
                            uint32_t info_count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkDeviceAddress* addresses, const uint32_t* strides,
                            const uint32_t* const* max_primitive_counts, std::vector<uint32_t>& captured);

@@ -5,13 +5,26 @@
 #include <atomic>
 
 #include "capture_reduce_jobs.h"
+#include "capture_run_end.h"
 
 namespace asval {
 namespace recording {
 
-void KeepOpen(const CaptureContext& ctx, CaptureRun& run, std::size_t copies_before) {
+void KeepOpen(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording,
+              std::size_t copies_before) {
+  CaptureRun& run = recording.capture_run;
   if (copies_before == 0 && !run.copies.empty()) run.aliases_epoch = ctx.aliases.Epoch();
-  if (!run.Empty()) run.Open(ctx.state.command_buffers.open_capture_runs());
+  if (run.Empty() || run.IsOpen()) return;
+  run.Open(ctx.state.command_buffers.open_capture_runs());
+  // Primaries only: the Khronos layer (1.3.239) takes a wait on an event set earlier in the same secondary for one
+  // on an event never set (VUID-vkCmdWaitEvents-srcStageMask-parameter, "instead is 0x0"); a secondary's capture
+  // point waits with a barrier.
+  const bool events = recording.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && !recording.simultaneous_use;
+  if (cb != VK_NULL_HANDLE && events && recording.capture_log) {
+    run.start_event = recording.capture_log->TakeEvent();
+    // Signaled once everything recorded before the run has executed (the stage mask its wait names too).
+    if (run.start_event != VK_NULL_HANDLE) ctx.next.CmdSetEvent(cb, run.start_event, kRunStartStages);
+  }
 }
 
 bool Reserve(const CaptureContext& ctx, CaptureLog& log, VkDeviceSize size, CapturedBytes* where) {

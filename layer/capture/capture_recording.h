@@ -21,8 +21,9 @@ namespace recording {
 
 // The run's captures planned by this command are in the run: it is open until its capture point
 // (capture_run_end.h). The run's first copy notes the aliases' epoch (a source destroyed before the capture point
-// is left out there).
-void KeepOpen(const CaptureContext& ctx, CaptureRun& run, std::size_t copies_before);
+// is left out there). A run that opens here sets its start event in cb, before the command that opened it (where
+// the recording may not use one, or none can be had, its capture point waits with a barrier).
+void KeepOpen(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording, std::size_t copies_before);
 
 // Room in the recording's slabs; false only when the pool could not give a slab (the device's memory, or the
 // layer's vkCreateBuffer / vkAllocateMemory / vkMapMemory, failed): counted as a capture memory failure.

@@ -37,14 +37,19 @@ void LeaveOutStaleCopies(const CaptureContext& ctx, CaptureRun& run, CaptureLog*
 }  // namespace
 
 void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::vector<CaptureCopy>& copies,
-                    const std::vector<CaptureDispatch>& dispatches, VkPipeline app_pipeline) {
+                    const std::vector<CaptureDispatch>& dispatches, VkPipeline app_pipeline, VkEvent start_event) {
   const bool reduces = !dispatches.empty();
   VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   before.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
   before.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | (reduces ? VK_ACCESS_SHADER_READ_BIT : 0);
-  ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
-                              VK_PIPELINE_STAGE_TRANSFER_BIT | (reduces ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : 0), 0,
-                              1, &before, 0, nullptr, 0, nullptr);
+  const VkPipelineStageFlags capture_stages =
+      VK_PIPELINE_STAGE_TRANSFER_BIT | (reduces ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : 0);
+  if (start_event != VK_NULL_HANDLE) {
+    ctx.next.CmdWaitEvents(cb, 1, &start_event, kRunStartStages, capture_stages, 1, &before, 0, nullptr, 0, nullptr);
+  } else {
+    ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, capture_stages, 0, 1, &before, 0, nullptr, 0,
+                                nullptr);
+  }
   for (const CaptureCopy& c : copies) ctx.next.CmdCopyBuffer(cb, c.src, c.dst, 1, &c.region);
   if (reduces) {
     VkPipeline bound = VK_NULL_HANDLE;
@@ -66,6 +71,8 @@ void RecordCaptures(const CaptureContext& ctx, VkCommandBuffer cb, const std::ve
   ctx.next.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | (reduces ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : 0),
                               VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after, 0, nullptr,
                               0, nullptr);
+  // After everything before it (the wait included: VUID-vkCmdResetEvent-event-03834), not before anything after.
+  if (start_event != VK_NULL_HANDLE) ctx.next.CmdResetEvent(cb, start_event, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
 }
 
 void RecordCaptureRun(const CaptureContext& ctx, VkCommandBuffer cb, CommandBufferState& recording) {
@@ -76,8 +83,12 @@ void RecordCaptureRun(const CaptureContext& ctx, VkCommandBuffer cb, CommandBuff
   }
   if (run.block.dispatch.jobs != 0) run.dispatches.push_back(run.block.dispatch);
   if (!run.copies.empty() || !run.dispatches.empty()) {
-    RecordCaptures(ctx, cb, run.copies, run.dispatches, recording.compute_pipeline);
+    RecordCaptures(ctx, cb, run.copies, run.dispatches, recording.compute_pipeline, run.start_event);
     ctx.counters.capture_points.fetch_add(1, std::memory_order_relaxed);
+  } else if (run.start_event != VK_NULL_HANDLE) {
+    // Nothing left to capture (every copy's source was destroyed): the event is still reset, as every execution
+    // that sets it must.
+    ctx.next.CmdResetEvent(cb, run.start_event, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
   }
   run.Close();
 }

@@ -30,7 +30,7 @@ const uint32_t* PreRecordCapture(DeviceData& data, VkCommandBuffer cb, uint32_t 
   const std::shared_ptr<CommandBufferState> recording = data.state.command_buffers.Find(cb);
   if (!recording) return nullptr;  // a command buffer the layer never saw: its submission makes history unknown
   const bool any_captured =
-      CaptureBuildInputs(MakeCaptureContext(data), *recording, info_count, infos, ranges, captured);
+      CaptureBuildInputs(MakeCaptureContext(data), cb, *recording, info_count, infos, ranges, captured);
   ReportCaptureBudget(MakeCheckContext(data), data.instance->settings.capture_budget_mb,
                       "vkCmdBuildAccelerationStructuresKHR");
   return any_captured ? captured.data() : nullptr;
@@ -83,7 +83,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
   if (data->capture_tracker) {
     if (const std::shared_ptr<CommandBufferState> recording = data->state.command_buffers.Find(commandBuffer)) {
       std::vector<uint32_t>& out = thread.data().captured_infos;
-      if (CaptureIndirectRanges(MakeCaptureContext(*data), *recording, infoCount, pInfos,
+      if (CaptureIndirectRanges(MakeCaptureContext(*data), commandBuffer, *recording, infoCount, pInfos,
                                 pIndirectDeviceAddresses, pIndirectStrides, ppMaxPrimitiveCounts, out)) {
         captured = out.data();
       }

@@ -60,7 +60,12 @@ VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer commandBuffer,
   DeviceData* data = GetDeviceData(commandBuffer);
   const VkResult result = data->dispatch.BeginCommandBuffer(commandBuffer, pBeginInfo);
   // vkBeginCommandBuffer resets a recorded command buffer implicitly.
-  if (result == VK_SUCCESS) data->state.command_buffers.Reset(commandBuffer);
+  if (result == VK_SUCCESS) {
+    // No begin info (invalid): taken as SIMULTANEOUS_USE, the case that uses no event (capture_run_end.h).
+    const VkCommandBufferUsageFlags usage =
+        pBeginInfo ? pBeginInfo->flags : VkCommandBufferUsageFlags{VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT};
+    data->state.command_buffers.Begin(commandBuffer, usage);
+  }
   return result;
 }
 

@@ -1,6 +1,7 @@
 #include "capture_log.h"
 
 #include <cstring>
+#include <new>
 
 namespace asval {
 
@@ -9,6 +10,17 @@ namespace {
 constexpr VkDeviceSize kAlignment = 16;
 
 }  // namespace
+
+VkEvent CaptureLog::TakeEvent() {
+  try {
+    events_.reserve(events_.size() + 1);  // before the event is taken: one taken is one given back
+  } catch (const std::bad_alloc&) {
+    return VK_NULL_HANDLE;
+  }
+  const VkEvent event = owner_->TakeEvent();
+  if (event != VK_NULL_HANDLE) events_.push_back(event);
+  return event;
+}
 
 bool CaptureLog::Reserve(VkDeviceSize size, CapturedBytes* where) {
   const VkDeviceSize used = used_.empty() ? 0 : used_.back();

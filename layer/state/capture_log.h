@@ -74,13 +74,18 @@ struct CaptureSlab {
   uint32_t table_index = UINT32_MAX;
 };
 
-// Where slabs come from and go back to (layer/capture's pool; destroyed with the device).
+// Where slabs and the capture points' events come from and go back to (layer/capture's pool; destroyed with the
+// device).
 class CaptureSlabOwner {
  public:
   virtual ~CaptureSlabOwner() = default;
   // A slab of at least `bytes`; false when none can be had (the capture is then skipped and counted).
   virtual bool Take(VkDeviceSize bytes, CaptureSlab* slab) = 0;
   virtual void Return(const CaptureSlab& slab) = 0;
+  // An unsignaled event; null when none can be had (the capture point then waits with a barrier).
+  virtual VkEvent TakeEvent() { return VK_NULL_HANDLE; }
+  // Given back unsignaled: every execution that set it reset it (capture_run_end.h).
+  virtual void ReturnEvent(VkEvent) {}
 };
 
 // A range of captured bytes in the log's slabs; size 0 with present: nothing to read (no primitives).
@@ -249,6 +254,7 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   explicit CaptureLog(std::shared_ptr<CaptureSlabOwner> owner) : owner_(std::move(owner)) {}
   ~CaptureLog() {
     for (const CaptureSlab& slab : slabs) owner_->Return(slab);
+    for (VkEvent event : events_) owner_->ReturnEvent(event);
   }
   CaptureLog(const CaptureLog&) = delete;
   CaptureLog& operator=(const CaptureLog&) = delete;
@@ -264,6 +270,9 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   uint32_t TableIndexOf(const CapturedBytes& bytes) const { return slabs[bytes.slab].table_index; }
   // The recording thread writes a reduce job's parameters (before any submission reads them).
   uint8_t* WritableBytes(const CapturedBytes& bytes) { return slabs[bytes.slab].mapped + bytes.offset; }
+  // An event for one run's capture point (capture_run.h), the log's until it is destroyed: no submission reads the
+  // recording any more then, so every execution of it has reset the event. Null when none can be had.
+  VkEvent TakeEvent();
 
   // ---- written by the recording thread (layer/capture's pre-record, through these) ----
   // Room for `size` bytes, 16-aligned, in the last slab or a new one; *where is set and marked present. False
@@ -342,6 +351,7 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
  private:
   std::shared_ptr<CaptureSlabOwner> owner_;
   std::vector<VkDeviceSize> used_;  // per slab, the bytes its captures use (from its start)
+  std::vector<VkEvent> events_;     // TakeEvent's, given back with the log
   uint32_t pending_submissions_ = 0;
   bool overlapped_ = false;
 };

@@ -58,6 +58,9 @@ class CaptureRun {
   // MemoryAliases::Epoch() when the run's first copy was planned: a copy's source buffer may have been destroyed
   // since only if it changed (the app freed memory while recording).
   uint64_t aliases_epoch = 0;
+  // The event set right before the run's first build (null: none, the capture point then waits with a barrier):
+  // its capture point waits for what came before the run, not for the run's builds (docs/capture.md).
+  VkEvent start_event = VK_NULL_HANDLE;
 
   bool Empty() const { return copies.empty() && dispatches.empty() && block.dispatch.jobs == 0; }
   bool IsOpen() const { return counted_ != nullptr; }
@@ -73,6 +76,7 @@ class CaptureRun {
     copies.clear();
     dispatches.clear();
     block = JobBlock{};
+    start_event = VK_NULL_HANDLE;  // the recording's log keeps it
     if (counted_) counted_->fetch_sub(1, std::memory_order_acq_rel);
     counted_ = nullptr;
   }

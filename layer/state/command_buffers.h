@@ -64,6 +64,9 @@ class CommandBufferState {
   // after the layer's reducing dispatch. Null: none bound yet in this recording, or the binding became undefined
   // (vkCmdExecuteCommands).
   VkPipeline compute_pipeline = VK_NULL_HANDLE;
+  // Begun with VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT: executions of this recording may overlap, so its
+  // capture points do not wait on events (one execution's set could release another's wait).
+  bool simultaneous_use = false;
   // The recording's capture log, made on its first capture with slabs from `owner`.
   CaptureLog& CaptureLogFor(const std::shared_ptr<CaptureSlabOwner>& owner) {
     if (!capture_log) {
@@ -131,6 +134,13 @@ class CommandBufferMap {
   // vkBeginCommandBuffer, vkResetCommandBuffer (after success): the recording starts empty.
   void Reset(VkCommandBuffer cb) {
     if (std::shared_ptr<CommandBufferState> state = Find(cb)) state->Reset();
+  }
+  // vkBeginCommandBuffer (after success): Reset, and the recording's usage.
+  void Begin(VkCommandBuffer cb, VkCommandBufferUsageFlags usage) {
+    if (std::shared_ptr<CommandBufferState> state = Find(cb)) {
+      state->Reset();
+      state->simultaneous_use = (usage & VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT) != 0;
+    }
   }
   // vkEndCommandBuffer (after success): the recording becomes what submissions and primaries see.
   void End(VkCommandBuffer cb);

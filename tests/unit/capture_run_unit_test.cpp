@@ -1,11 +1,15 @@
 // The capture point of a run of build commands (issue 27, capture_run.h, capture_run_end.h), over a fake next
-// dispatch table that counts what the layer records: one pair of barriers per run whatever it holds, the copies
-// whose source went away left out and counted, and the reduce jobs' blocks that a run grows.
+// dispatch table that counts what the layer records: one pair of barriers per run whatever it holds (or, in a
+// primary, the run's start event set, waited for and reset), the copies whose source went away left out and
+// counted, and the reduce jobs' blocks that a run grows.
 #include <catch2/catch_test_macros.hpp>
 
+#include <cstdio>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "capture_recording.h"
 #include "capture_reduce_jobs.h"
 #include "capture_run_end.h"
 #include "record_checks_harness.h"
@@ -18,19 +22,43 @@ H Fake(uintptr_t v) {
   return reinterpret_cast<H>(v);
 }
 
-// What the layer recorded through the fake next element of the chain.
+// What the layer recorded through the fake next element of the chain; `order` names each command in turn
+// (copy, barrier, set, wait, reset, with the event's and the stages' values where it has them).
 struct Recorded {
   int barriers = 0, copies = 0, binds = 0, dispatches = 0;
   VkPipeline last_bound = VK_NULL_HANDLE;
   uint32_t dispatched_jobs = 0;
+  std::vector<std::string> order;
 };
 Recorded recorded;
 
-void VKAPI_CALL CountCopy(VkCommandBuffer, VkBuffer, VkBuffer, uint32_t, const VkBufferCopy*) { ++recorded.copies; }
-void VKAPI_CALL CountBarrier(VkCommandBuffer, VkPipelineStageFlags, VkPipelineStageFlags, VkDependencyFlags, uint32_t,
-                             const VkMemoryBarrier*, uint32_t, const VkBufferMemoryBarrier*, uint32_t,
+std::string Hex(uint64_t v) {
+  char text[24];
+  std::snprintf(text, sizeof(text), "%llx", static_cast<unsigned long long>(v));
+  return text;
+}
+
+void VKAPI_CALL CountCopy(VkCommandBuffer, VkBuffer, VkBuffer, uint32_t, const VkBufferCopy*) {
+  ++recorded.copies;
+  recorded.order.push_back("copy");
+}
+void VKAPI_CALL CountBarrier(VkCommandBuffer, VkPipelineStageFlags src, VkPipelineStageFlags dst, VkDependencyFlags,
+                             uint32_t, const VkMemoryBarrier*, uint32_t, const VkBufferMemoryBarrier*, uint32_t,
                              const VkImageMemoryBarrier*) {
   ++recorded.barriers;
+  recorded.order.push_back("barrier " + Hex(src) + "->" + Hex(dst));
+}
+void VKAPI_CALL RecordSet(VkCommandBuffer, VkEvent event, VkPipelineStageFlags stages) {
+  recorded.order.push_back("set " + Hex(reinterpret_cast<uint64_t>(event)) + " " + Hex(stages));
+}
+void VKAPI_CALL RecordWait(VkCommandBuffer, uint32_t count, const VkEvent* events, VkPipelineStageFlags src,
+                           VkPipelineStageFlags dst, uint32_t, const VkMemoryBarrier*, uint32_t,
+                           const VkBufferMemoryBarrier*, uint32_t, const VkImageMemoryBarrier*) {
+  recorded.order.push_back("wait " + std::to_string(count) + " " + Hex(reinterpret_cast<uint64_t>(events[0])) + " " +
+                           Hex(src) + "->" + Hex(dst));
+}
+void VKAPI_CALL RecordReset(VkCommandBuffer, VkEvent event, VkPipelineStageFlags stages) {
+  recorded.order.push_back("reset " + Hex(reinterpret_cast<uint64_t>(event)) + " " + Hex(stages));
 }
 void VKAPI_CALL CountBind(VkCommandBuffer, VkPipelineBindPoint, VkPipeline pipeline) {
   ++recorded.binds;
@@ -55,6 +83,14 @@ class TableSlabs : public CaptureSlabOwner {
     return true;
   }
   void Return(const CaptureSlab&) override {}
+  // Events 0xe1, 0xe2, ... (none once `events_left` is 0); those given back are counted.
+  VkEvent TakeEvent() override {
+    if (events_left == 0) return VK_NULL_HANDLE;
+    --events_left;
+    return Fake<VkEvent>(0xe0 + ++events_taken);
+  }
+  void ReturnEvent(VkEvent) override { ++events_returned; }
+  int events_left = 8, events_taken = 0, events_returned = 0;
 
  private:
   std::vector<std::unique_ptr<std::vector<uint8_t>>> storage_;
@@ -75,6 +111,9 @@ struct Rig {
     next.CmdPipelineBarrier = CountBarrier;
     next.CmdBindPipeline = CountBind;
     next.CmdDispatchBase = CountDispatch;
+    next.CmdSetEvent = RecordSet;
+    next.CmdWaitEvents = RecordWait;
+    next.CmdResetEvent = RecordReset;
     pool = std::make_shared<CapturePool>(VK_NULL_HANDLE, next, VkPhysicalDeviceMemoryProperties{});
     aliases = std::make_unique<MemoryAliases>(VK_NULL_HANDLE, next, std::vector<uint32_t>{}, VkDeviceSize{1} << 30);
   }
@@ -197,6 +236,85 @@ TEST_CASE("capture run unit: a run's job block is taken larger than one command 
   CHECK_FALSE(block.ok);
   CHECK(block.Room() == 0);
   CHECK_FALSE(AcquireJobs(block, log, kReduceMaxJobsPerDispatch + 1, 64, pipeline));
+}
+
+
+// Issue 27 on a GPU: a capture point that waited for the run's builds (a barrier from ALL_COMMANDS) added its whole
+// dispatch to the frame. In a primary the run's start event is set before its first build and the capture point
+// waits for it, so the captures wait for what came before the run only (docs/capture.md).
+TEST_CASE("capture run unit: a primary's run sets its start event before its first build; the capture point waits "
+          "for it, then resets it after its barrier",
+          "[unit][capture]") {
+  Rig rig;
+  CaptureRun& run = rig.recording.capture_run;
+  rig.log();  // the recording's log, which takes the events
+  const std::string all = Hex(VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
+  const std::string transfer = Hex(VK_PIPELINE_STAGE_TRANSFER_BIT);
+  const std::string after =
+      Hex(VK_PIPELINE_STAGE_TRANSFER_BIT) + "->" + Hex(VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
+
+  SECTION("a primary: set when the run opens (once), waited for and reset at its capture point") {
+    run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x500), UINT32_MAX));
+    recording::KeepOpen(rig.Context(), kCb, rig.recording, 0);
+    run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x501), UINT32_MAX));
+    recording::KeepOpen(rig.Context(), kCb, rig.recording, 1);  // the run's second build: open already
+    CHECK(recorded.order == std::vector<std::string>{"set e1 " + all});
+    RecordCaptureRun(rig.Context(), kCb, rig.recording);
+    CHECK(recorded.order == std::vector<std::string>{"set e1 " + all, "wait 1 e1 " + all + "->" + transfer, "copy",
+                                                     "copy", "barrier " + after, "reset e1 " + all});
+    CHECK(run.start_event == VK_NULL_HANDLE);
+    // The next run takes an event of its own (the first is reset only once its wait has executed).
+    recorded.order.clear();
+    run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x502), UINT32_MAX));
+    recording::KeepOpen(rig.Context(), kCb, rig.recording, 0);
+    CHECK(recorded.order == std::vector<std::string>{"set e2 " + all});
+    RecordCaptureRun(rig.Context(), kCb, rig.recording);
+    CHECK(recorded.order.back() == "reset e2 " + all);
+    // Given back with the log, once no submission reads the recording.
+    rig.recording.Reset();
+    CHECK(rig.slabs->events_returned == 2);
+  }
+  SECTION("every copy left out: nothing is captured, and the event is still reset") {
+    CaptureLog& log = rig.log();
+    CapturedGeometry g;
+    const uint32_t info = log.AddInfo(CapturedInfo{}, &g, nullptr, 16) - 1;
+    run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x501), info));  // a dedicated buffer unknown to the state: gone
+    recording::KeepOpen(rig.Context(), kCb, rig.recording, 0);
+    rig.aliases->BufferDestroyed();
+    RecordCaptureRun(rig.Context(), kCb, rig.recording);
+    CHECK(recorded.order == std::vector<std::string>{"set e1 " + all, "reset e1 " + all});
+  }
+  SECTION("no event to be had: the capture point waits with a barrier") {
+    rig.slabs->events_left = 0;
+    run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x500), UINT32_MAX));
+    recording::KeepOpen(rig.Context(), kCb, rig.recording, 0);
+    RecordCaptureRun(rig.Context(), kCb, rig.recording);
+    CHECK(recorded.order == std::vector<std::string>{"barrier " + all + "->" + transfer, "copy", "barrier " + after});
+  }
+}
+
+TEST_CASE("capture run unit: a secondary, and a recording begun with SIMULTANEOUS_USE, wait with a barrier (no event)",
+          "[unit][capture]") {
+  Rig rig;
+  const std::string all = Hex(VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
+  const std::string transfer = Hex(VK_PIPELINE_STAGE_TRANSFER_BIT);
+  const auto capture = [&](CommandBufferState& recording) {
+    recording.CaptureLogFor(rig.slabs);
+    recording.capture_run.copies.push_back(CopyFrom(Fake<VkBuffer>(0x500), UINT32_MAX));
+    recording::KeepOpen(rig.Context(), kCb, recording, 0);
+    RecordCaptureRun(rig.Context(), kCb, recording);
+  };
+  SECTION("a secondary (the Khronos layer 1.3.239 misreads a wait on an event set in the same secondary)") {
+    CommandBufferState secondary{VK_NULL_HANDLE, VK_COMMAND_BUFFER_LEVEL_SECONDARY, false};
+    capture(secondary);
+  }
+  SECTION("SIMULTANEOUS_USE: one execution's set could release another's wait") {
+    rig.recording.simultaneous_use = true;
+    capture(rig.recording);
+  }
+  CHECK(recorded.order.size() == 3);
+  CHECK(recorded.order.front() == "barrier " + all + "->" + transfer);
+  CHECK(rig.slabs->events_taken == 0);
 }
 
 }  // namespace

@@ -491,7 +491,7 @@ TEST_CASE("indirect capture unit: the recorder keeps each geometry's range facts
   const uint32_t maxima[] = {1, 1, 1};
   const uint32_t* const max_counts[] = {maxima};
   std::vector<uint32_t> captured;
-  REQUIRE(CaptureIndirectRanges(ctx, recording, 1, &info, &address, &stride, max_counts, captured));
+  REQUIRE(CaptureIndirectRanges(ctx, VK_NULL_HANDLE, recording, 1, &info, &address, &stride, max_counts, captured));
   // The app's structures may change or go once the call returns: the log holds copies.
   triangles.geometry.triangles.maxVertex = 0;
   triangles.geometry.triangles.indexType = VK_INDEX_TYPE_NONE_KHR;

@@ -73,6 +73,24 @@ uint LoadBytes(uvec2 address, uint bytes) {
   return bytes == 4u ? value : value & ((1u << (8u * bytes)) - 1u);
 }
 
+// Indexed triangles: this group's 64 triangles' index bytes, read once by the whole group in aligned words (the
+// block's first byte is byte g_index_skew of the first word): each invocation takes its triangle's indices from
+// here, and the hash lanes walk them here rather than in device memory (a lane's steps are a chain, each of which
+// would otherwise wait for a load).
+shared uint s_index_words[194];  // 192 * 4 index bytes, one word of skew, one of spill
+uint g_index_skew;  // the same in every invocation of the group
+// The job, read once per group by its first invocation (it lies in host-visible memory: one read, not 64).
+shared Job s_job;
+
+// `bytes` (1 to 4) little-endian bytes at byte `offset` of the staged index block.
+uint StagedBytes(uint offset, uint bytes) {
+  const uint at = g_index_skew + offset;
+  const uint misalign = at & 3u;
+  uint value = s_index_words[at >> 2] >> (8u * misalign);
+  if (misalign + bytes > 4u) value |= s_index_words[(at >> 2) + 1u] << (32u - 8u * misalign);
+  return bytes == 4u ? value : value & ((1u << (8u * bytes)) - 1u);
+}
+
 // 64-bit words as uvec2(low, high): what the index hash (index_hash.cpp) computes, without shaderInt64.
 uvec2 Mul64(uvec2 a, uvec2 b) {
   uint hi, lo;
@@ -93,9 +111,9 @@ uvec2 Fmix64(uvec2 k) {  // murmur3's finaliser: k ^= k >> 33 is k.x ^= k.y >> 1
 }
 const uvec2 kPrime[4] = uvec2[4](uvec2(0x85EBCA87u, 0x9E3779B1u), uvec2(0x27D4EB4Fu, 0xC2B2AE3Du),
                                  uvec2(0x9E3779F9u, 0x165667B1u), uvec2(0x6659FD93u, 0xD6E8FEB8u));
-// Lane `lane` of the hash of `bytes` index bytes at `at` seeded with the element size: its word of each whole
-// 32-byte step, then its word of the tail (zero-padded), if the tail reaches it.
-uvec2 IndexHashLane(uvec2 at, uint bytes, uint seed, uint lane) {
+// Lane `lane` of the hash of the staged block's `bytes` index bytes seeded with the element size: its word of each
+// whole 32-byte step, then its word of the tail (zero-padded), if the tail reaches it.
+uvec2 IndexHashLane(uint bytes, uint seed, uint lane) {
   const uvec2 s = uvec2(seed, 0u);
   uvec2 h;
   if (lane == 0u) h = s ^ kPrime[0];
@@ -104,16 +122,16 @@ uvec2 IndexHashLane(uvec2 at, uint bytes, uint seed, uint lane) {
   else h = ~s ^ kPrime[3];
   const uint whole = bytes & ~31u;
   for (uint step = 0u; step < whole; step += 32u) {
-    const uvec2 word = Add64(at, step + 8u * lane, 0u);
-    const uvec2 w = uvec2(LoadBytes(word, 4u), LoadBytes(Add64(word, 4u, 0u), 4u));
+    const uint word = step + 8u * lane;
+    const uvec2 w = uvec2(StagedBytes(word, 4u), StagedBytes(word + 4u, 4u));
     h = Mul64(Rotl64(h ^ w, 29u), kPrime[lane]);
   }
   const uint tail = bytes - whole;
   if (8u * lane < tail) {
     const uint left = tail - 8u * lane;
-    const uvec2 word = Add64(at, whole + 8u * lane, 0u);
-    const uint high = left > 4u ? LoadBytes(Add64(word, 4u, 0u), min(4u, left - 4u)) : 0u;
-    const uvec2 w = uvec2(LoadBytes(word, min(4u, left)), high);
+    const uint word = whole + 8u * lane;
+    const uint high = left > 4u ? StagedBytes(word + 4u, min(4u, left - 4u)) : 0u;
+    const uvec2 w = uvec2(StagedBytes(word, min(4u, left)), high);
     h = Mul64(Rotl64(h ^ w, 29u), kPrime[lane]);
   }
   return h;
@@ -132,14 +150,12 @@ shared uint s_distinct;
 // Indexed triangles: the four lanes of the index hash of this group's 64 triangles.
 shared uvec2 s_lanes[4];
 
-void main() {
-  const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
-  const uvec2 slab = Addresses(uvec2(kTableLo, kTableHi)).a[job_index >> 16];
-  Job job = JobRef(AddProduct(slab, job_index & 0xffffu, 64u)).job;
-  // An indirect build's geometry (issue 28): where its bytes start and how many primitives it has are in its range
-  // info, on the device, read here where the build read it (after the build: nothing wrote it in between). The
-  // addresses of the job are then those of a range of offset 0, and its count the most the build may read; the
-  // results are laid out for the range's own count (the host reads that count from the range info it copied).
+// The job as the group uses it. An indirect build's geometry (issue 28): where its bytes start and how many
+// primitives it has are in its range info, on the device, read here where the build read it (after the build:
+// nothing wrote it in between). The addresses of the job are then those of a range of offset 0, and its count the
+// most the build may read; the results are laid out for the range's own count (the host reads that count from the
+// range info it copied).
+Job ReadJob(Job job) {
   if ((job.kind & 256u) != 0u) {
     const uint count = LoadBytes(job.range, 4u);
     const uint primitive_offset = LoadBytes(Add64(job.range, 4u, 0u), 4u);
@@ -157,6 +173,17 @@ void main() {
     }
     if (job.transform != uvec2(0u)) job.transform = Add64(job.transform, transform_offset, 0u);
   }
+  return job;
+}
+
+void main() {
+  if (gl_LocalInvocationID.x == 0u) {
+    const uint job_index = gl_WorkGroupID.y + 32768u * gl_WorkGroupID.z;
+    const uvec2 slab = Addresses(uvec2(kTableLo, kTableHi)).a[job_index >> 16];
+    s_job = ReadJob(JobRef(AddProduct(slab, job_index & 0xffffu, 64u)).job);
+  }
+  barrier();
+  const Job job = s_job;
   const uint x_kind = job.format & 255u;
   const uint components = (job.format >> 8) & 255u;
   const uint index_bytes = (job.format >> 16) & 255u;
@@ -197,6 +224,15 @@ void main() {
     if (local < 6u) s_bits[local / 2u][local % 2u] = (job.kind == 2u && local >= 4u) ? 0xffffffffu : 0u;
     if (local == 0u) s_distinct = 0u;
     s_refs[local] = uvec2(0u);
+    // Indexed triangles: these 64 triangles' index bytes, staged (their first byte at g_index_skew).
+    const uint block_first = 3u * group_first * index_bytes;
+    const uint block_bytes = min(192u * index_bytes, index_total - min(block_first, index_total));
+    if (job.kind == 0u && index_bytes != 0u) {
+      const uvec2 first = Add64(job.indices, block_first, 0u);
+      g_index_skew = first.x & 3u;
+      Words block = Words(uvec2(first.x & ~3u, first.y));
+      for (uint w = local; w < (g_index_skew + block_bytes + 3u) / 4u; w += 64u) s_index_words[w] = block.w[w];
+    }
     barrier();
     const uint t = group_first + local;
     bool is_active = false, undefined_input = false, unreadable = false;
@@ -207,7 +243,7 @@ void main() {
           if (index_bytes == 0u) {
             v[k] = 3u * t + k;
           } else {
-            const uint index = LoadBytes(AddProduct(job.indices, 3u * t + k, index_bytes), index_bytes);
+            const uint index = StagedBytes((3u * local + k) * index_bytes, index_bytes);
             uint carry;
             v[k] = uaddCarry(index, job.first_vertex, carry);
             unreadable = unreadable || carry != 0u || v[k] > job.max_vertex;
@@ -260,10 +296,8 @@ void main() {
       if (unreadable) atomicOr(s_bits[2][local / 32u], bit);
     }
     // Indexed triangles: these 64 triangles' indices hashed, one lane per invocation (each lane is a chain).
-    const uint block_first = 3u * group_first * index_bytes;
-    const uint block_bytes = min(192u * index_bytes, index_total - min(block_first, index_total));
     if (job.kind == 0u && index_bytes != 0u && local < 4u) {
-      s_lanes[local] = IndexHashLane(Add64(job.indices, block_first, 0u), block_bytes, index_bytes, local);
+      s_lanes[local] = IndexHashLane(block_bytes, index_bytes, local);
     }
     barrier();
     if (job.kind == 0u && index_bytes != 0u && local == 0u) {  // IndexHasher::Finish
