@@ -11,6 +11,26 @@ constexpr VkDeviceSize kAlignment = 16;
 
 }  // namespace
 
+void CaptureLog::GiveBack() {
+  for (const CaptureSlab& slab : slabs) owner_->Return(slab);
+  for (VkEvent event : events_) owner_->ReturnEvent(event);
+  slabs.clear();
+  events_.clear();
+}
+
+void CaptureLog::Recycle() {
+  GiveBack();
+  used_.clear();
+  bytes_captured = 0;
+  infos.clear();
+  geometries.clear();
+  max_primitive_counts.clear();
+  destinations.clear();
+  blobs.clear();
+  pending_submissions_ = 0;
+  overlapped_ = false;
+}
+
 VkEvent CaptureLog::TakeEvent() {
   try {
     events_.reserve(events_.size() + 1);  // before the event is taken: one taken is one given back

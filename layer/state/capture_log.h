@@ -252,10 +252,7 @@ MemorySpan ExecutedAccess(const CaptureLog& log, const CommandDestination& d);
 class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
  public:
   explicit CaptureLog(std::shared_ptr<CaptureSlabOwner> owner) : owner_(std::move(owner)) {}
-  ~CaptureLog() {
-    for (const CaptureSlab& slab : slabs) owner_->Return(slab);
-    for (VkEvent event : events_) owner_->ReturnEvent(event);
-  }
+  ~CaptureLog() { GiveBack(); }
   CaptureLog(const CaptureLog&) = delete;
   CaptureLog& operator=(const CaptureLog&) = delete;
 
@@ -273,6 +270,10 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   // An event for one run's capture point (capture_run.h), the log's until it is destroyed: no submission reads the
   // recording any more then, so every execution of it has reset the event. Null when none can be had.
   VkEvent TakeEvent();
+  // The log emptied for another recording of its command buffer, its vectors' storage kept; its slabs and events go
+  // back to the owner. Only where nothing else holds the log (no submission reads it).
+  void Recycle();
+  const std::shared_ptr<CaptureSlabOwner>& owner() const { return owner_; }
 
   // ---- written by the recording thread (layer/capture's pre-record, through these) ----
   // Room for `size` bytes, 16-aligned, in the last slab or a new one; *where is set and marked present. False
@@ -349,6 +350,8 @@ class CaptureLog : public std::enable_shared_from_this<CaptureLog> {
   std::vector<CapturedBytes> blobs;
 
  private:
+  void GiveBack();  // the slabs and events, to the owner
+
   std::shared_ptr<CaptureSlabOwner> owner_;
   std::vector<VkDeviceSize> used_;  // per slab, the bytes its captures use (from its start)
   std::vector<VkEvent> events_;     // TakeEvent's, given back with the log

@@ -27,7 +27,7 @@ void CommandBufferState::Reset() {
   recording_lost = false;
   secondaries.clear();
   if (capture_log) last_capture_log_size_ = capture_log->RecordCounts();
-  capture_log.reset();  // a submission still reading it keeps it
+  std::shared_ptr<CaptureLog> last_log = std::move(capture_log);  // a submission still reading it keeps it
   capture_run.Close();  // its reservations were in that log
   executed_capture_logs.clear();
   compute_pipeline = VK_NULL_HANDLE;
@@ -40,7 +40,17 @@ void CommandBufferState::Reset() {
     published_withheld_.reset();
   }
   // Nobody else can obtain it now; if nobody holds it either, its storage is ours to reuse.
-  if (old && old.use_count() == 1) spare_ = std::const_pointer_cast<RecordedOps>(std::move(old));
+  if (old && old.use_count() == 1) {
+    spare_ = std::const_pointer_cast<RecordedOps>(std::move(old));
+    spare_->capture_logs.clear();  // the logs are let go now, not at the next Publish
+  }
+  // Likewise the last recording's log, once no submission reads it: its slabs and events go back to the pool, its
+  // vectors are kept (a recording of hundreds of builds would otherwise allocate them anew every frame, where the
+  // allocator's large requests cost tens of thousands of instructions).
+  if (last_log && last_log.use_count() == 1) {
+    last_log->Recycle();
+    spare_log_ = std::move(last_log);
+  }
 }
 
 bool CommandBufferState::Publish() {

@@ -70,7 +70,12 @@ class CommandBufferState {
   // The recording's capture log, made on its first capture with slabs from `owner`.
   CaptureLog& CaptureLogFor(const std::shared_ptr<CaptureSlabOwner>& owner) {
     if (!capture_log) {
-      capture_log = std::make_shared<CaptureLog>(owner);
+      if (spare_log_ && spare_log_->owner() == owner) {
+        capture_log = std::move(spare_log_);
+      } else {
+        capture_log = std::make_shared<CaptureLog>(owner);
+      }
+      spare_log_.reset();
       capture_log->ReserveRecords(last_capture_log_size_);
     }
     return *capture_log;
@@ -109,6 +114,7 @@ class CommandBufferState {
   // A published snapshot nobody else holds any more, kept so that the next Publish reuses its storage: a
   // command buffer re-recorded every frame allocates nothing in the steady state.
   std::shared_ptr<RecordedOps> spare_;
+  std::shared_ptr<CaptureLog> spare_log_;  // the last recording's log, emptied (Reset), for the next one
 };
 
 class CommandBufferMap {
