@@ -82,7 +82,8 @@ class TableSlabs : public CaptureSlabOwner {
     slab->address = 0x100000000ull * storage_.size();
     return true;
   }
-  void Return(const CaptureSlab&) override {}
+  void Return(const CaptureSlab&) override { ++slabs_returned; }
+  int slabs_returned = 0;
   // Events 0xe1, 0xe2, ... (none once `events_left` is 0); those given back are counted.
   VkEvent TakeEvent() override {
     if (events_left == 0) return VK_NULL_HANDLE;
@@ -315,6 +316,39 @@ TEST_CASE("capture run unit: a secondary, and a recording begun with SIMULTANEOU
   CHECK(recorded.order.size() == 3);
   CHECK(recorded.order.front() == "barrier " + all + "->" + transfer);
   CHECK(rig.slabs->events_taken == 0);
+}
+
+TEST_CASE("capture run unit: a recording's log nobody else holds is emptied and reused by the next recording; one a "
+          "submission still holds is not",
+          "[unit][capture]") {
+  Rig rig;
+  CaptureLog& first = rig.log();
+  CapturedBytes bytes;
+  REQUIRE(first.Reserve(64, &bytes));
+  CapturedGeometry g;
+  first.AddInfo(CapturedInfo{}, &g, nullptr, 64);
+  REQUIRE(first.TakeEvent() != VK_NULL_HANDLE);
+  const CaptureLog* const first_address = &first;
+
+  SECTION("nobody else holds it: emptied, its slab and event given back, the same log serves the next recording") {
+    rig.recording.Reset();
+    CHECK(rig.slabs->slabs_returned == 1);
+    CHECK(rig.slabs->events_returned == 1);
+    CaptureLog& next = rig.log();
+    CHECK(&next == first_address);
+    CHECK(next.infos.empty());
+    CHECK(next.geometries.empty());
+    CHECK(next.slabs.empty());
+    CHECK(next.bytes_captured == 0);
+    CHECK(next.infos.capacity() >= 1);  // the storage kept
+  }
+  SECTION("a submission holds it: left alone, the next recording gets a new log") {
+    const std::shared_ptr<CaptureLog> held = rig.recording.capture_log;
+    rig.recording.Reset();
+    CHECK(rig.slabs->slabs_returned == 0);
+    CHECK(held->infos.size() == 1);
+    CHECK(&rig.log() != first_address);
+  }
 }
 
 }  // namespace
