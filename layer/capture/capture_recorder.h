@@ -3,8 +3,9 @@
 // execution time and plans their capture into the recording's capture log: one copy per input range or, where the
 // capture reduces on the device (capture_method, capture_reducer.h), one job of the layer's dispatch per geometry it
 // can read in place (capture_reduce_jobs.h). The copies and the dispatch join the recording's open run of build
-// commands (capture_run.h) and are recorded into the command buffer where the run ends, between two barriers
-// (capture_run_end.h): N build commands in a row cost one capture point.
+// commands (capture_run.h) and are recorded into the command buffer where the run ends, after a wait on the run's
+// start event (or a barrier) and before a barrier (capture_run_end.h): N build commands in a row cost one capture
+// point.
 //
 // Captured (setting `capture`): with `updates` (the default), bottom-level builds with ALLOW_UPDATE (a later
 // update's source: their activity record), updates, and every top-level build (its instance references); with

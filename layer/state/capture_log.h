@@ -203,7 +203,8 @@ struct CommandDestination {
 
 // Whether the layer's dispatch reads the record an instance pointer names (shaders/reduce_inputs.comp decides the
 // same): not 0 and aligned to 16 bytes (pInfos-03717; a misaligned one is reported, never chased). The build
-// itself reads 64 bytes there, right after the dispatch: the dispatch reads nothing the build would not read.
+// itself reads 64 bytes there (the dispatch runs after it, or beside it): the dispatch reads nothing the build would
+// not read.
 inline bool FollowedInstancePointer(uint64_t pointer) { return pointer != 0 && pointer % 16 == 0; }
 inline uint64_t InstancePointer(const uint8_t* pointers, uint32_t k) {
   uint64_t pointer = 0;

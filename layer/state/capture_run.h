@@ -4,7 +4,8 @@
 // recording's CaptureLog, the reduce jobs written), but the copies and the dispatch that fill them are recorded
 // once for the whole run, at its end: the first command after it that can order a later write of the builds'
 // inputs after their reads (a barrier, an event, a render pass, secondaries, the end of the command buffer),
-// between one pair of barriers. So N build commands in a row cost the device one capture point instead of N
+// after a wait on the run's start event (set before its first build; a barrier where there is none) and before a
+// barrier. So N build commands in a row cost the device one capture point instead of N
 // (layer/capture/capture_run_end.h records it; docs/capture.md says why the bytes are the ones the builds read).
 //
 // Threads: written only by the thread recording the command buffer, like CommandBufferState::recording. Only

@@ -13,7 +13,7 @@
 //   arrays of instance pointers (job kind 3, the second stage of their capture: where they point is known only
 //              now): the pointers as they are, then per pointer the 64-byte record it names, copied, when it is
 //              not 0 and aligned to 16 bytes (FollowedInstancePointer, capture_log.h: the build reads those 64
-//              bytes right after this dispatch; a misaligned one is pInfos-03717 and never chased), else zeros.
+//              bytes itself; a misaligned one is pInfos-03717 and never chased), else zeros.
 // Bit arrays hold one bit per primitive in 32-bit words (bit t % 32 of word t / 32), zero past the count. The
 // layout of the results is ReducedGeometry's (layer/state/capture_log.h).
 //
