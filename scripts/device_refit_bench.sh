@@ -15,20 +15,8 @@
 # Arguments are passed to the first run_refit.py (e.g. --structures 100,1000 --rounds 5). The timeouts keep the whole
 # command inside the device's 10 minutes (the table takes a few minutes there: 72 runs of about 100 frames).
 set -o pipefail
-for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
-export LD_LIBRARY_PATH=$PWD/.devrun/lib
-# run_refit.py gives every run the integration environment, lavapipe unless VK_DRIVER_FILES names a driver: name
-# NVIDIA's wherever that machine keeps it.
-for icd in /usr/share/vulkan/icd.d/nvidia_icd.json /etc/vulkan/icd.d/nvidia_icd.json \
-           /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json; do
-  if [ -f $icd ]; then export VK_DRIVER_FILES=$icd; break; fi
-done
-[ -n "$VK_DRIVER_FILES" ] || { echo "no NVIDIA Vulkan driver manifest found"; exit 1; }
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
-# A build folder of the shape run_refit.py expects (BUILD/bench/refit/refit_frames), holding the carried program.
-build=/tmp/refit-build; mkdir -p $build/bench/refit; cp .devrun/refit_frames $build/bench/refit/
+source scripts/device_refit_env.sh  # the loader, NVIDIA's driver, $build
 runner="python3 bench/refit/run_refit.py --build $build --layer-dir $PWD/.devrun/layer"
-export PYTHONUNBUFFERED=1
 timeout 400 $runner --json $OUT/refit-table.json "$@" 2>&1 | tee $OUT/refit-table.log
 # Host work per judged update against the triangle count (issue 27's target: the submit+wait time asval adds at 64
 # and at 4,096 triangles within 10% of each other).

@@ -8,15 +8,7 @@
 # Each variant runs 100 and 1,000 structures of 1,024 triangles and 100 of 64 and of 4,096, both shapes, against no
 # layer in the same run_refit.py call, one round each, twice over (variants interleaved); the table rows print.
 set -o pipefail
-for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
-export LD_LIBRARY_PATH=$PWD/.devrun/lib PYTHONUNBUFFERED=1
-for icd in /usr/share/vulkan/icd.d/nvidia_icd.json /etc/vulkan/icd.d/nvidia_icd.json \
-           /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json; do
-  if [ -f $icd ]; then export VK_DRIVER_FILES=$icd; break; fi
-done
-[ -n "$VK_DRIVER_FILES" ] || { echo "no NVIDIA Vulkan driver manifest found"; exit 1; }
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
-build=/tmp/refit-build; mkdir -p $build/bench/refit; cp .devrun/refit_frames $build/bench/refit/
+source scripts/device_refit_env.sh  # the loader, NVIDIA's driver, $build
 first=${VARIANTS%% *}
 for round in 1 2; do
   for v in ${VARIANTS:?name the variants: VARIANTS=\"a b\"}; do
