@@ -55,7 +55,7 @@ def families():
 
 def spec_vuids():
     data = load_json("scripts/vuids_newer.json")
-    newest = set(data["chapter_vuids"])
+    newest = set(data["chapter_vuids"]) | set(load_json("scripts/vuids_beyond_chapter.json")["vuids"])
     older = {old: new for new, olds in data["aliases"].items() for old in olds}
     return newest, older
 

@@ -67,20 +67,32 @@ CaptureTracker::Covered Everything() {
 
 namespace hooks {
 
+// The waits also tell the in-flight set (family lifetime, in_flight.h) what completed.
 VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
   DeviceData* data = GetDeviceData(queue);
-  return AfterWait(*data, data->dispatch.QueueWaitIdle(queue), Queue(queue));
+  const VkResult result = data->dispatch.QueueWaitIdle(queue);
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->QueueIdle(queue);
+  return AfterWait(*data, result, Queue(queue));
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL DeviceWaitIdle(VkDevice device) {
   DeviceData* data = GetDeviceData(device);
-  return AfterWait(*data, data->dispatch.DeviceWaitIdle(device), Everything());
+  const VkResult result = data->dispatch.DeviceWaitIdle(device);
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->DeviceIdle();
+  return AfterWait(*data, result, Everything());
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL WaitForFences(VkDevice device, uint32_t fenceCount, const VkFence* pFences,
                                              VkBool32 waitAll, uint64_t timeout) {
   DeviceData* data = GetDeviceData(device);
   const VkResult result = data->dispatch.WaitForFences(device, fenceCount, pFences, waitAll, timeout);
+  if (result == VK_SUCCESS && data->in_flight) {
+    if (waitAll || fenceCount == 1) {
+      data->in_flight->FencesSignaled(fenceCount, pFences, nullptr);
+    } else {
+      data->in_flight->Poll();  // waitAny: the fences that signaled are found by polling
+    }
+  }
   if (result == VK_SUCCESS && data->capture_tracker && !data->capture_tracker->idle()) {
     CaptureTracker::Covered covered;
     std::vector<VkFence> signaled;
@@ -105,14 +117,18 @@ VKAPI_ATTR VkResult VKAPI_CALL GetFenceStatus(VkDevice device, VkFence fence) {
   CaptureTracker::Covered covered;
   covered.fences = &fence;
   covered.fence_count = 1;
-  return AfterWait(*data, data->dispatch.GetFenceStatus(device, fence), covered);
+  const VkResult result = data->dispatch.GetFenceStatus(device, fence);
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->FencesSignaled(1, &fence, nullptr);
+  return AfterWait(*data, result, covered);
 }
 
 // Semaphore waits say nothing the layer maps to its submissions: what completed by now is processed.
 VKAPI_ATTR VkResult VKAPI_CALL WaitSemaphores(VkDevice device, const VkSemaphoreWaitInfo* pWaitInfo,
                                               uint64_t timeout) {
   DeviceData* data = GetDeviceData(device);
-  return AfterWait(*data, data->dispatch.WaitSemaphores(device, pWaitInfo, timeout), CaptureTracker::Covered{});
+  const VkResult result = data->dispatch.WaitSemaphores(device, pWaitInfo, timeout);
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->Poll();
+  return AfterWait(*data, result, CaptureTracker::Covered{});
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL GetSemaphoreCounterValue(VkDevice device, VkSemaphore semaphore, uint64_t* pValue) {
@@ -127,12 +143,16 @@ VKAPI_ATTR VkResult VKAPI_CALL ResetFences(VkDevice device, uint32_t fenceCount,
   if (data->capture_tracker && pFences) {
     for (uint32_t k = 0; k < fenceCount; ++k) data->capture_tracker->FenceRetired(pFences[k]);
   }
+  if (data->in_flight && pFences) {
+    for (uint32_t k = 0; k < fenceCount; ++k) data->in_flight->FenceRetired(pFences[k]);
+  }
   return data->dispatch.ResetFences(device, fenceCount, pFences);
 }
 
 VKAPI_ATTR void VKAPI_CALL DestroyFence(VkDevice device, VkFence fence, const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
   if (data->capture_tracker) data->capture_tracker->FenceRetired(fence);  // before: the handle may be reused
+  if (data->in_flight) data->in_flight->FenceRetired(fence);
   data->dispatch.DestroyFence(device, fence, pAllocator);
 }
 

@@ -1,17 +1,38 @@
 // Device-level hooks that keep the shadow state: memory, buffers, acceleration structures, object names.
 // Each calls down first and records only what the driver accepted.
+#include <functional>
 #include <mutex>
+#include <new>
 
 #include "capture_usage.h"
 #include "footprint_report.h"
 #include "history_host.h"
 #include "layer_data.h"
+#include "lifetime.h"
 #include "protect_notices.h"
+#include "protect_scope.h"
 #include "state_tracker.h"
 #include "vk_struct_chain.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
+
+namespace {
+
+// A destroy or free that the app's callback or protect mode kept from the driver while the device still uses the
+// object (family lifetime, lifetime.h): made once the work submitted before it completed (in_flight.h), so that
+// nothing leaks. Should that not fit in memory, it goes down now, as the app asked.
+void DeferDestroy(DeviceData& data, std::function<void()> destroy, VkBuffer buffer = VK_NULL_HANDLE,
+                  VkDeviceMemory memory = VK_NULL_HANDLE) {
+  try {
+    data.in_flight->Defer(data.state.NextObjectId(), destroy, buffer, memory);
+  } catch (const std::bad_alloc&) {
+    data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+    destroy();
+  }
+}
+
+}  // namespace
 
 VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCallbacks* pAllocator) {
   if (!device) return;
@@ -23,9 +44,13 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     CaptureTracker::Covered all;
     all.all = true;
     ProcessCaptures(*data, all);
+    // The device is idle: destroys the layer kept back run now (before the capture's alias buffers go), and the
+    // in-flight fences go (after the tracker polled them).
+    data->in_flight.reset();
     data->capture_tracker.reset();
     data->capture_pool->Shutdown();  // before the device goes; recordings still holding slabs give them back later
   }
+  if (data && data->in_flight) data->in_flight.reset();  // without the capture: the same, now
   if (data && data->capture_aliases) data->capture_aliases->Shutdown();  // the layer's buffers over app memory
   if (data) {
     {
@@ -63,6 +88,19 @@ VKAPI_ATTR VkResult VKAPI_CALL AllocateMemory(VkDevice device, const VkMemoryAll
 
 VKAPI_ATTR void VKAPI_CALL FreeMemory(VkDevice device, VkDeviceMemory memory, const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
+  if (memory && data->in_flight) {
+    const ProtectScope protect(data->reporter->protects());
+    if (CheckFreeMemoryInUse(MakeCheckContext(*data), *data->in_flight, memory)) {
+      // Kept from the driver until the work using it completed; the app's view of the memory ends now.
+      // The capture's alias buffer over it goes with it (the work may still copy through it).
+      RecordFreeMemory(data->state, memory);
+      DeferDestroy(*data, [data, device, memory, pAllocator] {
+        if (data->capture_aliases) data->capture_aliases->Forget(memory);
+        data->dispatch.FreeMemory(device, memory, pAllocator);
+      });
+      return;
+    }
+  }
   if (memory) RecordFreeMemory(data->state, memory);
   // After the state forgot the memory (no alias can be made for it from here) and before the downcall: the
   // layer's buffer over it goes first (memory_aliases.h).
@@ -100,6 +138,19 @@ VKAPI_ATTR void VKAPI_CALL GetDeviceBufferMemoryRequirements(VkDevice device,
 
 VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice device, VkBuffer buffer, const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
+  if (buffer && data->in_flight) {
+    const ProtectScope protect(data->reporter->protects());
+    if (CheckDestroyBufferInUse(MakeCheckContext(*data), *data->in_flight, buffer)) {
+      std::optional<std::shared_ptr<const BufferState>> record = data->state.buffers.find(buffer);
+      const VkDeviceMemory memory = record && *record ? (*record)->memory : VK_NULL_HANDLE;
+      RecordDestroyBuffer(data->state, buffer);
+      if (data->capture_aliases) data->capture_aliases->BufferDestroyed();
+      DeferDestroy(
+          *data, [data, device, buffer, pAllocator] { data->dispatch.DestroyBuffer(device, buffer, pAllocator); },
+          buffer, memory);
+      return;
+    }
+  }
   if (buffer) RecordDestroyBuffer(data->state, buffer);
   if (buffer && data->capture_aliases) data->capture_aliases->BufferDestroyed();
   data->dispatch.DestroyBuffer(device, buffer, pAllocator);
@@ -143,10 +194,20 @@ VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
                                                            VkAccelerationStructureKHR accelerationStructure,
                                                            const VkAllocationCallbacks* pAllocator) {
   DeviceData* data = GetDeviceData(device);
+  bool defer = false;
+  if (accelerationStructure && data->in_flight) {
+    const ProtectScope protect(data->reporter->protects());
+    defer = CheckDestroyStructureInUse(MakeCheckContext(*data), *data->in_flight, accelerationStructure);
+  }
   // Before the downcall: afterwards the handle value may be handed out again by another thread.
   if (accelerationStructure) {
     RecordDestroyAccelerationStructure(data->state, accelerationStructure);
     data->reporter->ForgetObjectName(Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, accelerationStructure));
+  }
+  if (defer) {
+    return DeferDestroy(*data, [data, device, accelerationStructure, pAllocator] {
+      data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
+    });
   }
   data->dispatch.DestroyAccelerationStructureKHR(device, accelerationStructure, pAllocator);
 }

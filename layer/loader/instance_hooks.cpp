@@ -161,6 +161,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
         instance->next_gipa(instance->instance, "vkSetDebugUtilsObjectNameEXT"));
   }
   data->state.history_tracked = instance->settings.TracksHistory();
+  data->state.lifetime_tracked = data->state.history_tracked && (instance->settings.enabled_checks & kCheckLifetime);
   const LayerSettings& settings = instance->settings;
   data->state.instance_activity_snapshots =
       settings.capture == kCaptureAll &&
@@ -185,6 +186,16 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
     data->capture_aliases = std::make_unique<MemoryAliases>(*pDevice, data->dispatch,
                                                              data->state.properties.queue_families,
                                                              data->state.properties.max_buffer_size);
+  }
+  if (data->state.lifetime_tracked) {
+    data->in_flight = std::make_unique<InFlight>(*pDevice, data->dispatch);
+    // The layer's fence of a submission with captures is polled by the capture tracker as the app's would be: it
+    // hears when the fence is reset for reuse.
+    if (data->capture_tracker) {
+      data->in_flight->SetFenceRecycledCallback(
+          [](void* tracker, VkFence fence) { static_cast<CaptureTracker*>(tracker)->FenceRetired(fence); },
+          data->capture_tracker.get());
+    }
   }
   Devices().Insert(GetDispatchKey(*pDevice), std::move(data));
   return VK_SUCCESS;

@@ -13,6 +13,7 @@
 #include "check_context.h"
 #include "device_state.h"
 #include "dispatch_key.h"
+#include "in_flight.h"
 #include "layer_settings.h"
 #include "reporter.h"
 #include "vk_dispatch_table.h"
@@ -42,6 +43,9 @@ struct DeviceData {
   std::unique_ptr<CaptureTracker> capture_tracker;
   // The layer's buffers over the app's memory that the capture's copies read through (memory_aliases.h).
   std::unique_ptr<MemoryAliases> capture_aliases;
+  // Submitted batches the device may still be running (family lifetime, in_flight.h): null when the family is off
+  // or the history is not tracked (no operations are recorded).
+  std::unique_ptr<InFlight> in_flight;
 };
 
 // What the capture's pre-record of a build sees.

@@ -31,6 +31,8 @@ VKAPI_ATTR VkResult VKAPI_CALL GetQueryPoolResults(VkDevice device, VkQueryPool 
   const VkResult result =
       data->dispatch.GetQueryPoolResults(device, queryPool, firstQuery, queryCount, dataSize, pData, stride, flags);
   RecordQueryResults(data->state, queryPool, firstQuery, queryCount, dataSize, pData, stride, flags, result);
+  // Results the device wrote: the host may learn from them that work in flight ran this far (in_flight.h).
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->HostReadDeviceProgress();
   return result;
 }
 

@@ -71,6 +71,55 @@ VkResult SynchronizeWithheld(DeviceData& data, const char* function, VkQueue que
   }
 }
 
+// Family lifetime (in_flight.h): the batches of a submission that use structures, buffers or memory, staged before
+// the downcall with the semaphores through which their completion may be learned. A wait of any submission for a
+// binary semaphore that a batch of another queue signals is noted (that batch may be seen complete through it).
+template <typename SemaphoresOf, typename ForEachCommandBufferIn>
+void StageInFlight(DeviceData& data, const char* function, VkQueue queue, uint32_t batch_count,
+                   SemaphoresOf&& semaphores_of, ForEachCommandBufferIn&& for_each_command_buffer_in,
+                   std::vector<InFlightBatch>& staging) {
+  InFlight& in_flight = *data.in_flight;
+  SubmissionOrder& order = data.state.history.order;
+  std::unique_lock<std::recursive_mutex> order_lock;  // timeline types are known under the order lock
+  if (order.any_timeline()) order_lock = std::unique_lock<std::recursive_mutex>(data.state.history.submission_order);
+  const auto timeline = [&](VkSemaphore s) { return order_lock.owns_lock() && order.IsTimeline(s); };
+  const uint64_t serial = data.state.NextObjectId();
+  const std::size_t first = staging.size();
+  for (uint32_t i = 0; i < batch_count; ++i) {
+    const BatchSemaphores semaphores = semaphores_of(i);
+    if (!in_flight.Empty()) {
+      for (uint32_t w = 0; w < semaphores.wait_count; ++w) {
+        const SemaphoreUse wait = semaphores.Wait(w);
+        if (!timeline(wait.semaphore)) in_flight.BinaryWaited(queue, wait.semaphore);
+      }
+    }
+    InFlightBatch* batch = nullptr;
+    for_each_command_buffer_in(i, [&](VkCommandBuffer cb, const Location&, uint32_t) {
+      std::shared_ptr<const RecordedOps> ops;
+      if (!RecordedOf(data.state, cb, &ops) || !ops) return;
+      if (!batch) {
+        batch = &in_flight.Stage(staging);
+        batch->serial = serial;
+        batch->queue = queue;
+        batch->function = function;
+        batch->submit_index = i;
+      }
+      batch->recorded.push_back(std::move(ops));
+    });
+    // Its signals, and every later batch's of the call, say it completed: added to each staged batch up to it.
+    for (uint32_t g = 0; g < semaphores.signal_count; ++g) {
+      const SemaphoreUse signal = semaphores.Signal(g);
+      for (std::size_t k = first; k < staging.size(); ++k) {
+        if (timeline(signal.semaphore)) {
+          staging[k].timeline_signals.push_back(signal);
+        } else {
+          staging[k].binary_signals.push_back(signal.semaphore);
+        }
+      }
+    }
+  }
+}
+
 // semaphores_of(i): batch i's BatchSemaphores; for_each_command_buffer_in(i, visit) calls visit(cb, location, j)
 // for every command buffer of batch i, in order. has_semaphores(): some batch waits or signals.
 // emptied_downcall(): the call's batches without their command buffers, with its fence (SynchronizeWithheld).
@@ -83,6 +132,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   // Captures of earlier submissions that completed are read first: a command buffer submitted again reuses
   // its capture memory (capture_tracker.h).
   ProcessCaptures(data, CaptureTracker::Covered{});
+  if (data.in_flight) data.in_flight->Poll();
   const auto for_each_command_buffer = [&](auto&& visit) {
     for (uint32_t i = 0; i < batch_count; ++i) {
       for_each_command_buffer_in(i, [&](VkCommandBuffer cb, const Location& loc, uint32_t) { visit(cb, loc); });
@@ -131,25 +181,48 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
     call.reset();  // what its batches noted is forgotten; the emptied batches are placed anew
     return SynchronizeWithheld(data, function, queue, batch_count, has_semaphores, semaphores_of, emptied_downcall);
   }
-  // Pre-record: the recordings whose captures run now count as pending before the device may write them.
-  // Without a fence of the app's, the layer's own goes down in its place and tells when the bytes are there.
+  // Pre-record: the batches that use structures, buffers or memory are staged as in flight (in_flight.h); without a
+  // fence of the app's, the layer's own goes down in its place and tells when they completed.
+  std::vector<InFlightBatch> in_flight;
+  VkFence in_flight_fence = VK_NULL_HANDLE;
+  if (data.in_flight) {
+    try {
+      StageInFlight(data, function, queue, batch_count, semaphores_of, for_each_command_buffer_in, in_flight);
+    } catch (const std::bad_alloc&) {
+      data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+      data.in_flight->Abandon(in_flight);  // not tracked: their destroys are not judged
+    }
+    if (!fence && !in_flight.empty()) in_flight_fence = data.in_flight->TakeFence();
+  }
+  const bool in_flight_fenced = !fence && !in_flight.empty();  // the layer's fence is the in-flight one (or none)
+  // The recordings whose captures run now count as pending before the device may write them. Without a fence of the
+  // app's, the layer's own goes down in its place and tells when the bytes are there (the in-flight fence, when
+  // there is one: the capture tracker polls it as the app's, and hears when it is reset for reuse).
   const SubmissionCaptures& held = submission.captures();
   const bool captures = data.capture_tracker && (!held.empty() || !held.logs.empty());
   VkFence layer_fence = VK_NULL_HANDLE;
   if (captures) {
     data.capture_tracker->Reserve(submission.captures());
-    if (!fence) layer_fence = data.capture_tracker->TakeFence();
+    if (!fence && !in_flight_fenced) layer_fence = data.capture_tracker->TakeFence();
   }
-  const VkResult result = downcall(fence ? fence : layer_fence);
+  const VkFence down_fence = fence ? fence : in_flight_fence ? in_flight_fence : layer_fence;
+  const VkResult result = downcall(down_fence);
   if (result != VK_SUCCESS) {
     if (captures) {
       data.capture_tracker->Unreserve(submission.captures());
       data.capture_tracker->ReturnFence(layer_fence);
     }
+    if (data.in_flight) {
+      data.in_flight->Abandon(in_flight);
+      data.in_flight->ReturnFence(in_flight_fence);
+    }
     submission.Undo();
     return result;  // the call's deferred batches are forgotten, its signals undone (~Call)
   }
-  if (captures) data.capture_tracker->Track(queue, fence, layer_fence, std::move(submission.captures()));
+  if (data.in_flight) data.in_flight->Commit(in_flight, fence ? fence : in_flight_fence, !fence);
+  if (captures) {
+    data.capture_tracker->Track(queue, fence ? fence : in_flight_fence, layer_fence, std::move(submission.captures()));
+  }
   if (call) {
     call->Commit();
     order.counters.batches_unordered.fetch_add(unordered_batches, std::memory_order_relaxed);

@@ -50,8 +50,8 @@ struct LayerSettings {
 #include "asval_settings_defs.inc"
 
   bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
-  // A family that needs the build history is enabled (history, or copies for dst-03561).
-  bool TracksHistory() const { return (enabled_checks & (kCheckHistory | kCheckCopies)) != 0; }
+  // A family that needs the recorded operations is enabled (history, copies for dst-03561, lifetime).
+  bool TracksHistory() const { return (enabled_checks & (kCheckHistory | kCheckCopies | kCheckLifetime)) != 0; }
 
   friend bool operator==(const LayerSettings& a, const LayerSettings& b) {
     bool same = true;

@@ -83,6 +83,7 @@ std::string DescribeOrigin(const OpOrigin& origin) {
 void OpBatch::Clear() {
   ops_.clear();
   geometries_.clear();
+  touches_.clear();
   applied_snapshots_.clear();
   lost_ = false;
 }
@@ -136,7 +137,7 @@ void OpBatch::AppendInPlace(const VkAccelerationStructureBuildGeometryInfoKHR& i
 void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                            const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                            const VkAccelerationStructureBuildRangeInfoKHR* const* ranges, CaptureLog* log,
-                           const uint32_t* captured, uint64_t max_geometry_count) {
+                           const uint32_t* captured, uint64_t max_geometry_count, bool touches) {
   for (uint32_t i = 0; i < info_count; ++i) {
     const VkAccelerationStructureBuildGeometryInfoKHR& info = infos[i];
     const bool has_geometries =
@@ -175,11 +176,96 @@ void OpBatch::AppendBuilds(const OpOrigin& origin, uint32_t info_count,
       }
     }
     if (op.geometries_unreadable || !has_geometries) op.geometry_count = 0;
+    // Device builds only: a host build's addresses are host pointers, and it completes within its call.
+    if (touches && origin.command != OpCommand::kHostBuild && has_geometries) {
+      AppendTouches(static_cast<uint32_t>(ops_.size() - 1), info);
+    }
   }
+}
+
+const char* TouchRoleName(TouchRole role) {
+  switch (role) {
+    case TouchRole::kScratch:
+      return "scratchData";
+    case TouchRole::kVertices:
+      return "vertexData";
+    case TouchRole::kIndices:
+      return "indexData";
+    case TouchRole::kTransform:
+      return "transformData";
+    case TouchRole::kAabbs:
+      return "aabbs data";
+    case TouchRole::kInstances:
+      return "instances data";
+    case TouchRole::kSerialized:
+      return "serialized bytes";
+  }
+  return "address";
+}
+
+void OpBatch::Append(const AsOp& op) {
+  ops_.push_back(op);
+  if ((op.kind == OpKind::kSerialize || op.kind == OpKind::kDeserialize) && op.memory.device_address != 0 &&
+      op.origin.command_buffer != VK_NULL_HANDLE) {
+    const uint32_t index = static_cast<uint32_t>(ops_.size() - 1);
+    touches_.push_back(AddressTouch{op.memory.device_address, index, TouchRole::kSerialized});
+  }
+}
+
+namespace {
+
+// Writes one touch at w; the next is written past it only when its address is non-zero. A plain function of
+// pointers, so that the loop keeps its write position in a register.
+[[gnu::always_inline]] inline AddressTouch* Put(AddressTouch* w, VkDeviceAddress address, uint32_t op, TouchRole role) {
+  w->address = address;
+  w->op = op;
+  w->role = role;
+  return w + (address != 0);
+}
+
+// The addresses of one geometry (`g` read once).
+[[gnu::always_inline]] inline AddressTouch* PutGeometry(AddressTouch* w, const VkAccelerationStructureGeometryKHR& g,
+                                                        uint32_t op) {
+  if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_KHR) {
+    const VkAccelerationStructureGeometryTrianglesDataKHR& t = g.geometry.triangles;
+    w = Put(w, t.vertexData.deviceAddress, op, TouchRole::kVertices);
+    w = Put(w, t.indexType != VK_INDEX_TYPE_NONE_KHR ? t.indexData.deviceAddress : 0, op, TouchRole::kIndices);
+    return Put(w, t.transformData.deviceAddress, op, TouchRole::kTransform);
+  }
+  if (g.geometryType == VK_GEOMETRY_TYPE_AABBS_KHR) {
+    return Put(w, g.geometry.aabbs.data.deviceAddress, op, TouchRole::kAabbs);
+  }
+  if (g.geometryType == VK_GEOMETRY_TYPE_INSTANCES_KHR) {
+    return Put(w, g.geometry.instances.data.deviceAddress, op, TouchRole::kInstances);
+  }
+  return w;
+}
+
+}  // namespace
+
+// Written in place into room for every address the info may name (scratch, then at most three per geometry), then
+// cut to what was written: per geometry, push_back's capacity test costs more than the touch itself.
+void OpBatch::AppendTouches(uint32_t op, const VkAccelerationStructureBuildGeometryInfoKHR& info) {
+  const std::size_t first = touches_.size();
+  AddressTouch* const out = touches_.Extend(1 + 3 * std::size_t{info.geometryCount});
+  AddressTouch* w = Put(out, info.scratchData.deviceAddress, op, TouchRole::kScratch);
+  if (info.pGeometries) {
+    for (uint32_t j = 0; j < info.geometryCount; ++j) w = PutGeometry(w, info.pGeometries[j], op);
+  } else {
+    for (uint32_t j = 0; j < info.geometryCount && info.ppGeometries[j]; ++j) {
+      w = PutGeometry(w, *info.ppGeometries[j], op);
+    }
+  }
+  touches_.Truncate(first + static_cast<std::size_t>(w - out));
 }
 
 void OpBatch::AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary) {
   if (secondary.lost_) lost_ = true;
+  const uint32_t first_op = static_cast<uint32_t>(ops_.size());
+  for (AddressTouch touch : secondary.touches_) {
+    touch.op += first_op;
+    touches_.push_back(touch);
+  }
   const uint32_t base = static_cast<uint32_t>(geometries_.size());
   geometries_.insert(geometries_.end(), secondary.geometries_.begin(), secondary.geometries_.end());
   for (AsOp op : secondary.ops_) {

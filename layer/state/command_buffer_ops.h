@@ -9,6 +9,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -165,11 +166,79 @@ struct AsOp {
 };
 static_assert(sizeof(AsOp) == 152, "no padding but the origin's: see the member order");
 
+// A device address an operation reads or writes (issue 29: what a pending submission holds in use). The first
+// byte of each range is enough to name the buffer and memory behind it (a range of a valid command lies in one
+// buffer). Device commands only: host commands complete within their call.
+enum class TouchRole : uint8_t { kScratch, kVertices, kIndices, kTransform, kAabbs, kInstances, kSerialized };
+// "scratchData", "vertexData", ... (the field that holds the address).
+const char* TouchRoleName(TouchRole role);
+// Trivial: the batch's array grows by `resize` (a memset) and is written in place.
+struct AddressTouch {
+  VkDeviceAddress address;
+  uint32_t op;  // index of the operation in its batch
+  TouchRole role;
+};
+static_assert(std::is_trivial_v<AddressTouch>, "grown by a memset, written in place");
+
+// A growable array of trivial records that grows without writing them (std::vector value-initializes what it
+// adds), for arrays written in place by the caller. Keeps its capacity across Clear.
+template <typename T>
+class TrivialArray {
+  static_assert(std::is_trivial_v<T>, "grown without construction, copied as bytes");
+
+ public:
+  TrivialArray() = default;
+  TrivialArray(const TrivialArray& other) { *this = other; }
+  TrivialArray& operator=(const TrivialArray& other) {
+    if (this != &other) {
+      clear();
+      if (other.size_ != 0) std::memcpy(Extend(other.size_), other.data_.get(), other.size_ * sizeof(T));
+    }
+    return *this;
+  }
+
+  const T* begin() const { return data_.get(); }
+  const T* end() const { return data_.get() + size_; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  void clear() { size_ = 0; }
+  // Room for `extra` more records past size(), not written: returns where they start. Throws std::bad_alloc.
+  T* Extend(std::size_t extra) {
+    if (size_ + extra > capacity_) Grow(size_ + extra);
+    T* at = data_.get() + size_;
+    size_ += extra;
+    return at;
+  }
+  // Keeps the first `size` records.
+  void Truncate(std::size_t size) { size_ = size < size_ ? size : size_; }
+  void push_back(const T& value) { *Extend(1) = value; }
+  void swap(TrivialArray& other) noexcept {
+    data_.swap(other.data_);
+    std::swap(size_, other.size_);
+    std::swap(capacity_, other.capacity_);
+  }
+
+ private:
+  void Grow(std::size_t needed) {
+    const std::size_t capacity = needed > 2 * capacity_ ? needed : 2 * capacity_;
+    std::unique_ptr<T[]> data(new T[capacity]);  // default-initialized: not written
+    if (size_ != 0) std::memcpy(data.get(), data_.get(), size_ * sizeof(T));
+    data_ = std::move(data);
+    capacity_ = capacity;
+  }
+
+  std::unique_ptr<T[]> data_;
+  std::size_t size_ = 0;
+  std::size_t capacity_ = 0;
+};
+
 // A sequence of operations in execution order, with their geometries.
 class OpBatch {
  public:
   const std::vector<AsOp>& ops() const { return ops_; }
   const std::vector<GeometryRecord>& geometries() const { return geometries_; }
+  // The device addresses the operations read or write (scratch, geometry inputs, serialized bytes).
+  const TrivialArray<AddressTouch>& touches() const { return touches_; }
   const GeometryRecord* GeometriesOf(const AsOp& op) const { return geometries_.data() + op.first_geometry; }
   bool empty() const { return ops_.empty(); }
   // The operations could not all be recorded (an allocation failed: host commands, history_recorder.cpp): what
@@ -182,6 +251,7 @@ class OpBatch {
   void Swap(OpBatch& other) noexcept {
     ops_.swap(other.ops_);
     geometries_.swap(other.geometries_);
+    touches_.swap(other.touches_);
     applied_snapshots_.swap(other.applied_snapshots_);
     std::swap(lost_, other.lost_);
   }
@@ -201,12 +271,14 @@ class OpBatch {
   // captured: per info, its index in `log`'s infos plus one (0: not captured); null when nothing was.
   // max_geometry_count: the device's limit (0: not reported); past it an info's geometries are not read (its arrays
   // may be shorter than its count, type-03793) and its operation's geometries are unreadable.
+  // touches: a device build's addresses are kept (touches()); false where nothing reads them (family lifetime off).
   void AppendBuilds(const OpOrigin& origin, uint32_t info_count,
                     const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
-                    CaptureLog* log = nullptr, const uint32_t* captured = nullptr, uint64_t max_geometry_count = 0);
-  // Any other operation (no geometries).
-  void Append(const AsOp& op) { ops_.push_back(op); }
+                    CaptureLog* log = nullptr, const uint32_t* captured = nullptr, uint64_t max_geometry_count = 0,
+                    bool touches = true);
+  // Any other operation (no geometries); device serialization and deserialization touch their bytes.
+  void Append(const AsOp& op);
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.
   void AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary);
   // The operations appended so far that read their captures from `from` read them from `to` instead (the
@@ -223,7 +295,11 @@ class OpBatch {
                      const VkAccelerationStructureBuildRangeInfoKHR* info_ranges);
 
   std::vector<AsOp> ops_;
+  // The geometry inputs and scratch of one device build (operation index op), appended to touches_.
+  void AppendTouches(uint32_t op, const VkAccelerationStructureBuildGeometryInfoKHR& info);
+
   std::vector<GeometryRecord> geometries_;
+  TrivialArray<AddressTouch> touches_;
   mutable std::vector<std::shared_ptr<const BuildSnapshot>> applied_snapshots_;
   bool lost_ = false;
 };

@@ -59,6 +59,9 @@ class DeviceState {
   // The settings enable a family that needs the build history (history, or copies for dst-03561): operations
   // are recorded and applied only then.
   bool history_tracked = true;
+  // Family lifetime is on: device builds keep the addresses they read and write (OpBatch::touches), which the
+  // in-flight checks look up when an object is destroyed (layer/checks/lifetime.h).
+  bool lifetime_tracked = true;
   // With capture = all, degenerate instances (the degenerate_instance capture warning, info severity) or instance
   // translations (the float_spacing capture warning) are judged: each captured top-level build keeps the activity
   // of every live structure as of its submission.

@@ -149,7 +149,7 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
   const OpOrigin origin = DeviceOrigin(*recording, command, cb);
   Guarded(state, *recording, [&] {
     recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured,
-                                      state.properties.acceleration_structure.maxGeometryCount);
+                                      state.properties.acceleration_structure.maxGeometryCount, state.lifetime_tracked);
   });
 }
 

@@ -45,12 +45,17 @@ struct BufferState {
   bool memory_freed = false;
   // Queried by the layer itself at bind time when the usage has SHADER_DEVICE_ADDRESS; 0 otherwise.
   VkDeviceAddress device_address = 0;
+  // DeviceState::NextObjectId() when it was bound: a submission made before holds no address of it that it could
+  // have found through another buffer since destroyed (in_flight.h: an address is not an identity).
+  uint64_t bound_serial = 0;
 
   bool Contains(VkDeviceSize offset, VkDeviceSize bytes) const { return offset <= size && bytes <= size - offset; }
 };
 
 struct AccelerationStructureState {
   VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+  // DeviceState::NextObjectId() at creation: a submission made before it cannot name it (handles are reused).
+  uint64_t serial = 0;
   VkBuffer buffer = VK_NULL_HANDLE;
   uint64_t buffer_id = 0;  // BufferState::id of that buffer when the structure was created (0: unknown buffer)
   VkDeviceSize offset = 0;

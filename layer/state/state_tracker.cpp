@@ -229,6 +229,7 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
   record->bound = true;
   record->memory = memory;
   record->memory_offset = offset;
+  record->bound_serial = state.NextObjectId();
   if ((record->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) && dispatch.GetBufferDeviceAddress) {
     const VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, buffer};
     record->device_address = dispatch.GetBufferDeviceAddress(device, &info);
@@ -260,6 +261,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   InjectBadAlloc(FailSite::kStructureRecord);
   auto record = std::make_shared<AccelerationStructureState>();
   record->handle = handle;
+  record->serial = state.NextObjectId();
   record->buffer = info.buffer;
   record->offset = info.offset;
   record->size = info.size;

@@ -106,6 +106,8 @@ class SubmissionOrder {
   void SemaphoreImported(VkSemaphore semaphore);
   // vkSignalSemaphore succeeded.
   void Signaled(VkSemaphore semaphore, uint64_t value);
+  // A timeline semaphore the layer saw created (with the lock held).
+  bool IsTimeline(VkSemaphore semaphore) { return FindTimeline(semaphore) != nullptr; }
 
   // One vkQueueSubmit / vkQueueSubmit2 / vkQueueBindSparse call, batch by batch, with the lock held until the
   // call's downcall returned: Commit when it succeeded; otherwise the destructor forgets what Place noted.

@@ -1,0 +1,183 @@
+#include "lifetime.h"
+
+#include <fmt/format.h>
+
+#include "structure_memory.h"
+
+namespace asval {
+
+namespace {
+
+constexpr const char kStructureInUse[] = "VUID-vkDestroyAccelerationStructureKHR-accelerationStructure-02442";
+constexpr const char kBufferInUse[] = "VUID-vkDestroyBuffer-buffer-00922";
+constexpr const char kMemoryInUse[] = "VUID-vkFreeMemory-memory-00677";
+
+void CountSkips(const CheckContext& ctx, const InFlightSkips& skips) {
+  const uint64_t n = skips.no_fence + skips.host_may_know;
+  if (n != 0) ctx.state.checks_skipped_unknown_state.fetch_add(n, std::memory_order_relaxed);
+}
+
+// The structure an operation names, as the batch submitted it: alive then (created before the submission).
+std::shared_ptr<const AccelerationStructureState> StructureOf(const CheckContext& ctx, VkAccelerationStructureKHR as,
+                                                              uint64_t submitted) {
+  if (!as) return nullptr;
+  std::optional<std::shared_ptr<const AccelerationStructureState>> record = ctx.state.acceleration_structures.find(as);
+  if (!record || !*record || (*record)->serial > submitted) return nullptr;
+  return *record;
+}
+
+// The live buffers holding `address` that were bound before the submission `submitted`: calls hold(BufferState).
+template <typename Hold>
+void ForEachHolder(const CheckContext& ctx, VkDeviceAddress address, uint64_t submitted, Hold&& hold) {
+  AddressHits hits;
+  ctx.state.buffer_addresses.FindContaining(address, hits);
+  for (const AddressHit& hit : hits) {
+    std::optional<std::shared_ptr<const BufferState>> b = ctx.state.buffers.find(hit.buffer);
+    if (!b || !*b || !(*b)->bound || (*b)->memory_freed || (*b)->bound_serial > submitted) continue;
+    hold(**b);
+  }
+}
+
+// Where an operation of a batch came from, for the message.
+std::string Describe(const InFlightBatch& batch, const AsOp& op) {
+  return fmt::format("{}, submitted to VkQueue 0x{:x} by {} pSubmits[{}]", DescribeOrigin(op.origin),
+                     reinterpret_cast<uint64_t>(batch.queue), batch.function ? batch.function : "a submission",
+                     batch.submit_index);
+}
+
+template <typename Uses>
+void ForEachOp(const InFlightBatch& batch, Uses&& uses) {
+  for (const std::shared_ptr<const RecordedOps>& recorded : batch.recorded) {
+    if (!recorded) continue;
+    for (const AsOp& op : recorded->batch.ops()) uses(*recorded, op);
+  }
+}
+
+[[gnu::cold, gnu::noinline]] bool Report(const CheckContext& ctx, const char* vuid, const char* function,
+                                         ReportObject object, const std::string& text) {
+  return ctx.reporter.Report(Severity::kError, vuid, Location(function), {object}, text);
+}
+
+constexpr const char kNotDone[] =
+    "; that submission has not completed execution (its fence is unsignaled), and the device would read or write "
+    "freed memory";
+
+}  // namespace
+
+bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, VkAccelerationStructureKHR structure) {
+  if (!ctx.Enabled(kCheckLifetime) || in_flight.Empty()) return false;
+  const std::shared_ptr<const AccelerationStructureState> record = StructureOf(ctx, structure, ~uint64_t{0});
+  if (!record) return false;
+  const auto uses = [&](const AsOp& op) { return op.src == structure || op.dst == structure; };
+  InFlightSkips skips;
+  bool skip = false;
+  in_flight.ForEachRunning(
+      [&](const InFlightBatch& b) {
+        if (b.serial < record->serial) return false;
+        bool used = false;
+        ForEachOp(b, [&](const RecordedOps&, const AsOp& op) { used |= uses(op); });
+        return used;
+      },
+      [&](const InFlightBatch& b) {
+        const AsOp* first = nullptr;
+        ForEachOp(b, [&](const RecordedOps&, const AsOp& op) {
+          if (!first && uses(op)) first = &op;
+        });
+        if (!first) return;
+        skip |= Report(ctx, kStructureInUse, "vkDestroyAccelerationStructureKHR",
+                       Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, structure),
+                       fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
+                                   reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
+      },
+      &skips);
+  CountSkips(ctx, skips);
+  return skip;
+}
+
+namespace {
+
+// What a pending batch uses of the object being destroyed: the first operation found, and how.
+struct FoundUse {
+  const AsOp* op = nullptr;
+  std::string how;
+};
+
+// The first use of a buffer or memory by a batch: `lost(holder)` says whether a buffer holding a touched address (or a
+// structure's buffer) goes away with the object; a touched address is used only when every holder that stays...
+// none does and one goes.
+template <typename Goes>
+FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, Goes&& goes) {
+  FoundUse found;
+  for (const std::shared_ptr<const RecordedOps>& recorded : b.recorded) {
+    if (!recorded) continue;
+    const std::vector<AsOp>& ops = recorded->batch.ops();
+    for (const AddressTouch& touch : recorded->batch.touches()) {
+      bool going = false, staying = false;
+      ForEachHolder(ctx, touch.address, b.serial,
+                    [&](const BufferState& holder) { (goes(holder) ? going : staying) = true; });
+      if (going && !staying && touch.op < ops.size()) {
+        found.op = &ops[touch.op];
+        found.how = fmt::format("its {} (0x{:x})", TouchRoleName(touch.role), touch.address);
+        return found;
+      }
+    }
+    for (const AsOp& op : ops) {
+      for (VkAccelerationStructureKHR as : {op.src, op.dst}) {
+        const std::shared_ptr<const AccelerationStructureState> s = StructureOf(ctx, as, b.serial);
+        if (!s) continue;
+        const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, *s);
+        if (!buffer || !buffer->bound || buffer->bound_serial > b.serial || !goes(*buffer)) continue;
+        found.op = &op;
+        found.how = fmt::format("the storage of VkAccelerationStructureKHR 0x{:x}", reinterpret_cast<uint64_t>(as));
+        return found;
+      }
+    }
+  }
+  return found;
+}
+
+template <typename Goes>
+bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, const char* function,
+                ReportObject object, const char* what, Goes&& goes) {
+  InFlightSkips skips;
+  bool skip = false;
+  in_flight.ForEachRunning([&](const InFlightBatch& b) { return FirstUse(ctx, b, goes).op != nullptr; },
+                           [&](const InFlightBatch& b) {
+                             const FoundUse use = FirstUse(ctx, b, goes);
+                             if (!use.op) return;
+                             skip |= Report(
+                                 ctx, vuid, function, object,
+                                 fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
+                           },
+                           &skips);
+  CountSkips(ctx, skips);
+  return skip;
+}
+
+}  // namespace
+
+bool CheckDestroyBufferInUse(const CheckContext& ctx, InFlight& in_flight, VkBuffer buffer) {
+  if (!ctx.Enabled(kCheckLifetime) || in_flight.Empty()) return false;
+  std::optional<std::shared_ptr<const BufferState>> record = ctx.state.buffers.find(buffer);
+  if (!record || !*record || !(*record)->bound) return false;
+  const uint64_t id = (*record)->id;
+  const std::string what = fmt::format("VkBuffer 0x{:x}", reinterpret_cast<uint64_t>(buffer));
+  return CheckInUse(ctx, in_flight, kBufferInUse, "vkDestroyBuffer", Obj(VK_OBJECT_TYPE_BUFFER, buffer), what.c_str(),
+                    [&](const BufferState& holder) { return holder.id == id; });
+}
+
+bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDeviceMemory memory) {
+  if (!ctx.Enabled(kCheckLifetime) || in_flight.Empty()) return false;
+  const std::string what = fmt::format("VkDeviceMemory 0x{:x}", reinterpret_cast<uint64_t>(memory));
+  // A buffer on it whose destroy was kept back because pending work uses it: that work uses this memory.
+  if (const VkBuffer kept = in_flight.DeferredBufferOn(memory)) {
+    return Report(ctx, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),
+                  fmt::format("{} is bound to VkBuffer 0x{:x}, destroyed while a pending submission used it (the layer "
+                              "keeps it until that submission completes){}.",
+                              what, reinterpret_cast<uint64_t>(kept), kNotDone));
+  }
+  return CheckInUse(ctx, in_flight, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),
+                    what.c_str(), [&](const BufferState& holder) { return holder.memory == memory; });
+}
+
+}  // namespace asval
