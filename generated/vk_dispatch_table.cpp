@@ -113,6 +113,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->GetDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(gdpa(device, "vkGetDeviceProcAddr"));
   table->GetDeviceQueue = reinterpret_cast<PFN_vkGetDeviceQueue>(gdpa(device, "vkGetDeviceQueue"));
   table->GetDeviceQueue2 = reinterpret_cast<PFN_vkGetDeviceQueue2>(gdpa(device, "vkGetDeviceQueue2"));
+  table->GetEventStatus = reinterpret_cast<PFN_vkGetEventStatus>(gdpa(device, "vkGetEventStatus"));
   table->GetFenceStatus = reinterpret_cast<PFN_vkGetFenceStatus>(gdpa(device, "vkGetFenceStatus"));
   table->GetQueryPoolResults = reinterpret_cast<PFN_vkGetQueryPoolResults>(gdpa(device, "vkGetQueryPoolResults"));
   static constexpr const char* kGetSemaphoreCounterValueNames[] = {"vkGetSemaphoreCounterValue", "vkGetSemaphoreCounterValueKHR"};

@@ -91,6 +91,7 @@ struct DeviceDispatchTable {
   PFN_vkGetDeviceProcAddr GetDeviceProcAddr = nullptr;
   PFN_vkGetDeviceQueue GetDeviceQueue = nullptr;
   PFN_vkGetDeviceQueue2 GetDeviceQueue2 = nullptr;
+  PFN_vkGetEventStatus GetEventStatus = nullptr;
   PFN_vkGetFenceStatus GetFenceStatus = nullptr;
   PFN_vkGetQueryPoolResults GetQueryPoolResults = nullptr;
   PFN_vkGetSemaphoreCounterValue GetSemaphoreCounterValue = nullptr;

@@ -67,6 +67,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkGetDeferredOperationResultKHR",
     "vkGetDeviceBufferMemoryRequirements",
     "vkGetDeviceBufferMemoryRequirementsKHR",
+    "vkGetEventStatus",
     "vkGetFenceStatus",
     "vkGetQueryPoolResults",
     "vkGetSemaphoreCounterValue",
@@ -153,6 +154,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkGetDeferredOperationResultKHR
     true,  // vkGetDeviceBufferMemoryRequirements
     true,  // vkGetDeviceBufferMemoryRequirementsKHR
+    true,  // vkGetEventStatus
     true,  // vkGetFenceStatus
     true,  // vkGetQueryPoolResults
     true,  // vkGetSemaphoreCounterValue

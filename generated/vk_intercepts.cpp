@@ -71,6 +71,7 @@ const InterceptEntry kIntercepts[] = {
     {"vkGetDeferredOperationResultKHR", reinterpret_cast<PFN_vkVoidFunction>(&GetDeferredOperationResultKHR), true},
     {"vkGetDeviceBufferMemoryRequirements", reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceBufferMemoryRequirements), true},
     {"vkGetDeviceBufferMemoryRequirementsKHR", reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceBufferMemoryRequirements), true},
+    {"vkGetEventStatus", reinterpret_cast<PFN_vkVoidFunction>(&GetEventStatus), true},
     {"vkGetFenceStatus", reinterpret_cast<PFN_vkVoidFunction>(&GetFenceStatus), true},
     {"vkGetQueryPoolResults", reinterpret_cast<PFN_vkVoidFunction>(&GetQueryPoolResults), true},
     {"vkGetSemaphoreCounterValue", reinterpret_cast<PFN_vkVoidFunction>(&GetSemaphoreCounterValue), true},

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <string>
+#include <vector>
+
 #include "structure_memory.h"
 
 namespace asval {
@@ -70,7 +73,7 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
   if (!record) return false;
   const auto uses = [&](const AsOp& op) { return op.src == structure || op.dst == structure; };
   InFlightSkips skips;
-  bool skip = false;
+  std::vector<std::string> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
       [&](const InFlightBatch& b) {
         if (b.serial < record->serial) return false;
@@ -84,13 +87,16 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
           if (!first && uses(op)) first = &op;
         });
         if (!first) return;
-        skip |= Report(ctx, kStructureInUse, "vkDestroyAccelerationStructureKHR",
-                       Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, structure),
-                       fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
-                                   reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
+        findings.push_back(fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
+                                       reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
       },
       &skips);
   CountSkips(ctx, skips);
+  bool skip = false;
+  for (const std::string& text : findings) {
+    skip |= Report(ctx, kStructureInUse, "vkDestroyAccelerationStructureKHR",
+                   Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, structure), text);
+  }
   return skip;
 }
 
@@ -140,17 +146,18 @@ template <typename Goes>
 bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, const char* function,
                 ReportObject object, const char* what, Goes&& goes) {
   InFlightSkips skips;
-  bool skip = false;
-  in_flight.ForEachRunning([&](const InFlightBatch& b) { return FirstUse(ctx, b, goes).op != nullptr; },
-                           [&](const InFlightBatch& b) {
-                             const FoundUse use = FirstUse(ctx, b, goes);
-                             if (!use.op) return;
-                             skip |= Report(
-                                 ctx, vuid, function, object,
-                                 fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
-                           },
-                           &skips);
+  std::vector<std::string> findings;  // reported once the in-flight set's lock is released
+  in_flight.ForEachRunning(
+      [&](const InFlightBatch& b) { return FirstUse(ctx, b, goes).op != nullptr; },
+      [&](const InFlightBatch& b) {
+        const FoundUse use = FirstUse(ctx, b, goes);
+        if (!use.op) return;
+        findings.push_back(fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
+      },
+      &skips);
   CountSkips(ctx, skips);
+  bool skip = false;
+  for (const std::string& text : findings) skip |= Report(ctx, vuid, function, object, text);
   return skip;
 }
 

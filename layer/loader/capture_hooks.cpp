@@ -137,6 +137,15 @@ VKAPI_ATTR VkResult VKAPI_CALL GetSemaphoreCounterValue(VkDevice device, VkSemap
                    CaptureTracker::Covered{});
 }
 
+// An event the device set tells the host that the work before it ran, before its submission's fence signals: the
+// batches in flight may be known complete that early (in_flight.h: their destroys are then skipped and counted).
+VKAPI_ATTR VkResult VKAPI_CALL GetEventStatus(VkDevice device, VkEvent event) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.GetEventStatus(device, event);
+  if (result == VK_EVENT_SET && data->in_flight) data->in_flight->HostReadDeviceProgress();
+  return result;
+}
+
 // The app may reset or destroy a fence only once the submissions it was given to completed.
 VKAPI_ATTR VkResult VKAPI_CALL ResetFences(VkDevice device, uint32_t fenceCount, const VkFence* pFences) {
   DeviceData* data = GetDeviceData(device);

@@ -40,6 +40,8 @@ VKAPI_ATTR void VKAPI_CALL DestroySemaphore(VkDevice device, VkSemaphore semapho
     std::lock_guard<std::recursive_mutex> lock(data->state.history.submission_order);
     data->state.history.order.SemaphoreDestroyed(semaphore);
   }
+  // The batches that signal it completed (it may be destroyed only then); the handle no longer names them.
+  if (semaphore && data->in_flight) data->in_flight->SemaphoreDestroyed(semaphore);
   data->dispatch.DestroySemaphore(device, semaphore, pAllocator);
 }
 

@@ -146,6 +146,26 @@ void InFlight::FenceRetired(VkFence fence) {
   RetireCompleted();
 }
 
+void InFlight::SemaphoreDestroyed(VkSemaphore semaphore) {
+  if (Empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (std::size_t k = batches_.size(); k-- > 0;) {
+    InFlightBatch& b = batches_[k];
+    const auto named = [&](const SemaphoreUse& s) { return s.semaphore == semaphore; };
+    const bool timeline =
+        std::find_if(b.timeline_signals.begin(), b.timeline_signals.end(), named) != b.timeline_signals.end();
+    const bool binary =
+        std::find(b.binary_signals.begin(), b.binary_signals.end(), semaphore) != b.binary_signals.end();
+    if (!timeline && !binary) continue;
+    if (!b.complete) CompleteUpTo(k);
+    b.timeline_signals.erase(std::remove_if(b.timeline_signals.begin(), b.timeline_signals.end(), named),
+                             b.timeline_signals.end());
+    b.binary_signals.erase(std::remove(b.binary_signals.begin(), b.binary_signals.end(), semaphore),
+                           b.binary_signals.end());
+  }
+  RetireCompleted();
+}
+
 void InFlight::BinaryWaited(VkQueue queue, VkSemaphore semaphore) {
   if (Empty()) return;
   std::lock_guard<std::mutex> lock(mutex_);

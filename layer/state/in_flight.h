@@ -87,6 +87,9 @@ class InFlight {
   void FencesSignaled(uint32_t count, const VkFence* fences, const bool* signaled);
   // vkResetFences / vkDestroyFence: the app's fence no longer names its batches, which completed.
   void FenceRetired(VkFence fence);
+  // vkDestroySemaphore: the batches that signal it completed (the app may destroy it only then), and the handle no
+  // longer names them (it is not polled again).
+  void SemaphoreDestroyed(VkSemaphore semaphore);
   // Another submission on `queue` waits for a binary semaphore: a batch of another queue that signals it may be
   // seen complete through that submission.
   void BinaryWaited(VkQueue queue, VkSemaphore semaphore);
@@ -115,6 +118,7 @@ class InFlight {
     }
     RetireCompleted();
   }
+  // visit runs with the set's lock held: it must not report (an app callback may call Vulkan), only note what to.
   // Retires the batches whose fences read signaled (at each submission and wait).
   void Poll();
   // vkDestroyDevice (after the device is idle): everything completed.

@@ -3,7 +3,9 @@
 // wait the host signals after the destroy, so that the device cannot have finished it; the destroys the tests
 // expect are skipped by the monitor's VK_TRUE, which the layer honours by making them once the work completed.
 #include <catch2/catch_test_macros.hpp>
+#include <chrono>
 #include <memory>
+#include <thread>
 
 #include "history_helpers.h"
 
@@ -96,6 +98,155 @@ TEST_CASE(
     CHECK(gate.HostSignal(2) == VK_SUCCESS);
     CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
   }
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+VkFence MakeFence(vkkit::Device& device) {
+  VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  REQUIRE(vkCreateFence(device.handle(), &info, nullptr, &fence) == VK_SUCCESS);
+  return fence;
+}
+
+VkResult SubmitWithFence(VkQueue queue, VkCommandBuffer cb, VkFence fence) {
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  return vkQueueSubmit(queue, 1, &submit, fence);
+}
+
+TEST_CASE(
+    "lifetime: the buffer a structure was created on, destroyed before the submission building the structure "
+    "completed, is reported (buffer-00922)",
+    "[integration][lifetime]") {
+  HistoryFixture f("lifetime", {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline gate(device);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { blas.Build(c, Shape{}); });
+  REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);
+  f.monitor().Expect(kBufferInUse);
+  blas.DestroyStorageBuffer();
+  const std::vector<Message> messages = f.monitor().Take();
+  REQUIRE(messages.size() == 1);
+  CHECK(messages[0].text.find("the storage of VkAccelerationStructureKHR") != std::string::npos);
+  CHECK(gate.HostSignal(1) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "lifetime valid twin: frames in flight with the app's fences, each frame's inputs destroyed once its fence "
+    "was waited for while the next frame is pending, stay silent",
+    "[integration][lifetime]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  Timeline gate(device);
+  Inputs base(device);
+  Blas blas(device, base);
+  device.OneShot([&](VkCommandBuffer cb) { blas.Build(cb, Shape{}); });
+  constexpr int kFrames = 4;
+  std::vector<std::unique_ptr<Inputs>> inputs;
+  std::vector<VkFence> fences;
+  for (int frame = 0; frame < kFrames; ++frame) {
+    inputs.push_back(std::make_unique<Inputs>(device));  // this frame's vertices
+    fences.push_back(MakeFence(device));
+    blas.SetInputs(*inputs.back());
+    const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { blas.Update(c, Shape{}); });
+    if (frame + 1 < kFrames) {
+      REQUIRE(SubmitWithFence(device.queue(), cb, fences.back()) == VK_SUCCESS);
+    } else {
+      // The last frame is held pending (a timeline wait) while the earlier frames' inputs go.
+      REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);
+    }
+    if (frame >= 1 && frame + 1 < kFrames) {
+      // Deferred deletion: the frame before this one, once its fence was waited for.
+      REQUIRE(vkWaitForFences(device.handle(), 1, &fences[frame - 1], VK_TRUE, kTenSeconds) == VK_SUCCESS);
+      inputs[frame - 1].reset();
+    }
+  }
+  REQUIRE(vkWaitForFences(device.handle(), 1, &fences[kFrames - 2], VK_TRUE, kTenSeconds) == VK_SUCCESS);
+  inputs[kFrames - 2].reset();
+  CHECK(f.monitor().Verify() == "");
+  CHECK(gate.HostSignal(1) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  for (VkFence fence : fences) vkDestroyFence(device.handle(), fence, nullptr);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "lifetime valid twin: an alias of the input buffer over the same memory destroyed while the build is "
+    "pending stays silent (the build's buffer still holds the address)",
+    "[integration][lifetime]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  Inputs inputs(device);
+  Blas blas(device, inputs);
+  Commands commands(device);
+  Timeline gate(device);
+  // A second buffer over the inputs' memory (a view a sub-allocator keeps): lavapipe gives it the same address.
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = inputs.buffer().size;
+  info.usage =
+      VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+  VkBuffer alias = VK_NULL_HANDLE;
+  REQUIRE(vkCreateBuffer(device.handle(), &info, nullptr, &alias) == VK_SUCCESS);
+  REQUIRE(vkBindBufferMemory(device.handle(), alias, inputs.buffer().memory, 0) == VK_SUCCESS);
+  const VkBufferDeviceAddressInfo address{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, alias};
+  REQUIRE(vkGetBufferDeviceAddress(device.handle(), &address) == inputs.buffer().address);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { blas.Build(c, Shape{}); });
+  REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);
+  vkDestroyBuffer(device.handle(), alias, nullptr);
+  CHECK(f.monitor().Verify() == "");
+  CHECK(gate.HostSignal(1) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "lifetime valid twin: inputs destroyed once the host saw an event the device set after the build, while "
+    "the rest of the submission is pending, stay silent",
+    "[integration][lifetime]") {
+  HistoryFixture f(nullptr, {}, TimelineDevice());
+  vkkit::Device& device = f.device();
+  auto inputs = std::make_unique<Inputs>(device);
+  Blas blas(device, *inputs);
+  Commands commands(device);
+  VkEventCreateInfo event_info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+  VkEvent built = VK_NULL_HANDLE, go_on = VK_NULL_HANDLE;
+  REQUIRE(vkCreateEvent(device.handle(), &event_info, nullptr, &built) == VK_SUCCESS);
+  REQUIRE(vkCreateEvent(device.handle(), &event_info, nullptr, &go_on) == VK_SUCCESS);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) {
+    blas.Build(c, Shape{});
+    vkCmdSetEvent(c, built, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+    // The rest of the submission waits for the host.
+    vkCmdWaitEvents(c, 1, &go_on, VK_PIPELINE_STAGE_HOST_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, nullptr, 0, nullptr, 0,
+                    nullptr);
+  });
+  const VkFence fence = MakeFence(device);
+  REQUIRE(SubmitWithFence(device.queue(), cb, fence) == VK_SUCCESS);
+  VkResult status = VK_EVENT_RESET;
+  for (int tries = 0; tries < 10000 && status != VK_EVENT_SET; ++tries) {
+    status = vkGetEventStatus(device.handle(), built);
+    if (status != VK_EVENT_SET) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  REQUIRE(status == VK_EVENT_SET);
+  inputs.reset();  // the build ran: its inputs may go, though the submission's fence has not signaled
+  CHECK(f.monitor().Verify() == "");
+  REQUIRE(vkSetEvent(device.handle(), go_on) == VK_SUCCESS);
+  REQUIRE(vkWaitForFences(device.handle(), 1, &fence, VK_TRUE, kTenSeconds) == VK_SUCCESS);
+  vkDestroyFence(device.handle(), fence, nullptr);
+  vkDestroyEvent(device.handle(), built, nullptr);
+  vkDestroyEvent(device.handle(), go_on, nullptr);
   CHECK(f.monitor().Verify() == "");
 }
 
