@@ -16,8 +16,10 @@ constexpr const char kBufferInUse[] = "VUID-vkDestroyBuffer-buffer-00922";
 constexpr const char kMemoryInUse[] = "VUID-vkFreeMemory-memory-00677";
 
 void CountSkips(const CheckContext& ctx, const InFlightSkips& skips) {
-  const uint64_t n = skips.no_fence + skips.host_may_know;
-  if (n != 0) ctx.state.checks_skipped_unknown_state.fetch_add(n, std::memory_order_relaxed);
+  DeviceState::LifetimeCounters& c = ctx.state.lifetime_counters;
+  c.calls_judged.fetch_add(1, std::memory_order_relaxed);
+  c.skipped_no_fence.fetch_add(skips.no_fence, std::memory_order_relaxed);
+  c.skipped_host_may_know.fetch_add(skips.host_may_know, std::memory_order_relaxed);
 }
 
 // The structure an operation names, as the batch submitted it: alive then (created before the submission).
@@ -185,6 +187,27 @@ bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDevice
   }
   return CheckInUse(ctx, in_flight, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),
                     what.c_str(), [&](const BufferState& holder) { return holder.memory == memory; });
+}
+
+void ReportLifetimeSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const DeviceState::LifetimeCounters& c = state.lifetime_counters;
+  const uint64_t judged = c.calls_judged.load(std::memory_order_relaxed);
+  if (judged == 0) return;
+  const NamedCount reasons[] = {{"no_fence", c.skipped_no_fence.load(std::memory_order_relaxed)},
+                                {"host_may_know", c.skipped_host_may_know.load(std::memory_order_relaxed)}};
+  const std::string text = fmt::format(
+      "Objects in use by the device (lifetime): {} destroys and frees were judged against the work in flight, {} of "
+      "them made by the layer once that work completed (the app's callback or protect mode skipped them); pending "
+      "batches not judged: no_fence={} (no fence to ask), host_may_know={} (the host may have known them complete "
+      "before their fence: it read an event or query results, or another queue waited for their binary semaphore).",
+      judged, c.kept_back.load(std::memory_order_relaxed), reasons[0].count, reasons[1].count);
+  const NamedCounts counts{"lifetime_skipped", reasons, 2};
+  const Location where("vkDestroyDevice");
+  if (reasons[0].count + reasons[1].count != 0) {
+    reporter.ReportUnchecked(kLifetimeSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);
+  } else {
+    reporter.Report(Severity::kInfo, kLifetimeSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);
+  }
 }
 
 }  // namespace asval

@@ -20,4 +20,9 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
 bool CheckDestroyBufferInUse(const CheckContext& ctx, InFlight& in_flight, VkBuffer buffer);
 bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDeviceMemory memory);
 
+inline constexpr const char kLifetimeSummaryId[] = "ASVAL-Lifetime-Summary";
+// vkDestroyDevice: what the family judged and could not judge (info; in the JSON report whenever something was
+// skipped).
+void ReportLifetimeSummary(const DeviceState& state, Reporter& reporter, VkDevice device);
+
 }  // namespace asval

@@ -45,6 +45,15 @@ void ReportWithheldHostCommand(const CheckContext& ctx, const char* function, Vk
                   Cause(cause.vuid(), cause.where())));
 }
 
+void ReportDeferredDestroy(const CheckContext& ctx, const char* function, VkDevice device, const ProtectScope& cause) {
+  ctx.reporter.ReportLayerAction(
+      kProtectWithheldId, Location(function), {Obj(VK_OBJECT_TYPE_DEVICE, device)},
+      fmt::format("protect: this call was not passed down now because asval reported {}; the layer makes it once the "
+                  "work that uses the object completed (at the latest at vkDestroyDevice), so that the device never "
+                  "reads or writes freed memory and nothing leaks.",
+                  Cause(cause.vuid(), cause.where())));
+}
+
 void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, VkQueue queue, VkCommandBuffer cb,
                               const WithheldCommand& command) {
   ctx.reporter.ReportLayerAction(

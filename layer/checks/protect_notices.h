@@ -21,6 +21,9 @@ void ReportWithheldCommand(const CheckContext& ctx, const char* function, VkComm
 // A host command (build, copy, property write) that returned VK_ERROR_VALIDATION_FAILED_EXT without running.
 void ReportWithheldHostCommand(const CheckContext& ctx, const char* function, VkDevice device,
                                const ProtectScope& cause);
+// A destroy or free not passed down now because the device still uses the object (family lifetime): the layer
+// makes it once that work completed.
+void ReportDeferredDestroy(const CheckContext& ctx, const char* function, VkDevice device, const ProtectScope& cause);
 // A submission not passed down because the command buffer at `cb_loc` holds a withheld command.
 void ReportWithheldSubmission(const CheckContext& ctx, const Location& cb_loc, VkQueue queue, VkCommandBuffer cb,
                               const WithheldCommand& command);

@@ -26,6 +26,7 @@ void DeferDestroy(DeviceData& data, std::function<void()> destroy, VkBuffer buff
                   VkDeviceMemory memory = VK_NULL_HANDLE) {
   try {
     data.in_flight->Defer(data.state.NextObjectId(), destroy, buffer, memory);
+    data.state.lifetime_counters.kept_back.fetch_add(1, std::memory_order_relaxed);
   } catch (const std::bad_alloc&) {
     data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
     destroy();
@@ -60,6 +61,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     }
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
+    ReportLifetimeSummary(data->state, *data->reporter, device);
   }
   if (data) data->reporter->ForgetObjectNames(device);  // its queues' and its objects' left undestroyed
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);
@@ -91,6 +93,7 @@ VKAPI_ATTR void VKAPI_CALL FreeMemory(VkDevice device, VkDeviceMemory memory, co
   if (memory && data->in_flight) {
     const ProtectScope protect(data->reporter->protects());
     if (CheckFreeMemoryInUse(MakeCheckContext(*data), *data->in_flight, memory)) {
+      if (protect.withheld()) ReportDeferredDestroy(MakeCheckContext(*data), "vkFreeMemory", device, protect);
       // Kept from the driver until the work using it completed; the app's view of the memory ends now.
       // The capture's alias buffer over it goes with it (the work may still copy through it).
       RecordFreeMemory(data->state, memory);
@@ -141,6 +144,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyBuffer(VkDevice device, VkBuffer buffer, const
   if (buffer && data->in_flight) {
     const ProtectScope protect(data->reporter->protects());
     if (CheckDestroyBufferInUse(MakeCheckContext(*data), *data->in_flight, buffer)) {
+      if (protect.withheld()) ReportDeferredDestroy(MakeCheckContext(*data), "vkDestroyBuffer", device, protect);
       std::optional<std::shared_ptr<const BufferState>> record = data->state.buffers.find(buffer);
       const VkDeviceMemory memory = record && *record ? (*record)->memory : VK_NULL_HANDLE;
       RecordDestroyBuffer(data->state, buffer);
@@ -198,6 +202,9 @@ VKAPI_ATTR void VKAPI_CALL DestroyAccelerationStructureKHR(VkDevice device,
   if (accelerationStructure && data->in_flight) {
     const ProtectScope protect(data->reporter->protects());
     defer = CheckDestroyStructureInUse(MakeCheckContext(*data), *data->in_flight, accelerationStructure);
+    if (defer && protect.withheld()) {
+      ReportDeferredDestroy(MakeCheckContext(*data), "vkDestroyAccelerationStructureKHR", device, protect);
+    }
   }
   // Before the downcall: afterwards the handle value may be handed out again by another thread.
   if (accelerationStructure) {

@@ -99,6 +99,15 @@ class DeviceState {
   // Checks skipped because the state they need is unknown (a limit the driver did not report, an object the
   // layer never saw): counted, never guessed. Shown in summaries.
   mutable std::atomic<uint64_t> checks_skipped_unknown_state{0};
+  // Family lifetime (layer/checks/lifetime.h): destroys and frees judged against the work in flight, and why some of
+  // that work could not be judged.
+  struct LifetimeCounters {
+    std::atomic<uint64_t> calls_judged{0};    // destroys and frees of an object some work in flight may use
+    std::atomic<uint64_t> kept_back{0};       // destroys the layer made later (skipped by the app or protect mode)
+    std::atomic<uint64_t> skipped_no_fence{0};       // batches with no fence to ask
+    std::atomic<uint64_t> skipped_host_may_know{0};  // batches the host may know complete before their fence
+  };
+  mutable LifetimeCounters lifetime_counters;
   // Calls protect mode kept from the driver, and whether an error judged at completion halted submissions
   // (protect_marks.h).
   ProtectCounters protect_counters;

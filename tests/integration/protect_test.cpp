@@ -844,5 +844,31 @@ TEST_CASE("protect: threads recording withheld and valid commands at once each g
         }) == withheld_jobs);
 }
 
+
+TEST_CASE("protect: a buffer destroyed while a pending build reads it is kept until the build completed, named by a "
+          "notice (buffer-00922)",
+          "[integration][protect][lifetime]") {
+  ProtectRun run("lifetime", true, "", true, nullptr, TimelineDevice());
+  vkkit::Device& device = run.device();
+  auto inputs = std::make_unique<Inputs>(device);
+  Blas blas(device, *inputs);
+  Commands commands(device);
+  Timeline gate(device);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { blas.Build(c, Shape{}); });
+  REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);  // runs once the host signals 1
+  const vkkit::Buffer held = inputs->buffer();
+  vkDestroyBuffer(device.handle(), held.buffer, nullptr);  // kept back: the build still reads it
+  vkFreeMemory(device.handle(), held.memory, nullptr);     // kept back too: the kept buffer is bound to it
+  (void)inputs.release();
+  CHECK(run.TakeFindings() == Strings{"VUID-vkDestroyBuffer-buffer-00922", "VUID-vkFreeMemory-memory-00677"});
+  const Strings notices = run.TakeNotices();
+  REQUIRE(notices.size() == 2);
+  CHECK(Contains(notices[0], "makes it once the work that uses the object completed"));
+  // The build runs on the bytes it was given (nothing was freed under it), and the layer then makes both calls.
+  CHECK(gate.HostSignal(1) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(run.TakeFindings().empty());
+}
+
 }  // namespace
 }  // namespace asval_test
