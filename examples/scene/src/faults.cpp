@@ -23,6 +23,7 @@ const char* WhenName(FaultWhen when) {
     case FaultWhen::kRecord: return "record";
     case FaultWhen::kSubmit: return "submit";
     case FaultWhen::kExecution: return "execution";
+    case FaultWhen::kDestroy: return "destroy";
   }
   return "?";
 }

@@ -12,7 +12,7 @@ enum class FaultId {
 #undef SCENE_FAULT
 };
 
-enum class FaultWhen { kRecord, kSubmit, kExecution };
+enum class FaultWhen { kRecord, kSubmit, kExecution, kDestroy };
 
 struct FaultInfo {
   FaultId id;

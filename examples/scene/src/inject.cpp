@@ -105,6 +105,7 @@ class Injector {
   void UpdateIndices();
   void DestroyedInstance();
   void QueryWithoutCompaction();
+  void ScratchDestroyedPending();
 
   Scene& s_;
   Gpu& gpu_;
@@ -130,6 +131,7 @@ void Injector::Run() {
     case FaultId::kUpdateIndices: return UpdateIndices();
     case FaultId::kDestroyedInstance: return DestroyedInstance();
     case FaultId::kQueryWithoutCompaction: return QueryWithoutCompaction();
+    case FaultId::kScratchDestroyedPending: return ScratchDestroyedPending();
   }
 }
 
@@ -320,6 +322,40 @@ void Injector::QueryWithoutCompaction() {
                                                           VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, pool, 0);
   });
   vkDestroyQueryPool(gpu_.device(), pool, nullptr);
+}
+
+void Injector::ScratchDestroyedPending() {
+  // A build of a spare structure that waits for an event the host sets only after the scratch buffer's handle is
+  // destroyed: the build is certainly pending then. The memory stays allocated until the build completed, so the
+  // build reads and writes live memory whether or not asval keeps the destroy back (protect mode does).
+  const BuildInput& ground = s_.statics.input(StaticBlases::kGround);
+  const VkAccelerationStructureBuildSizesInfoKHR sizes = ground.QuerySizes(gpu_);
+  AccelerationStructure& spare =
+      pad_.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize, "spare");
+  Buffer& scratch = pad_.NewScratch(sizes.buildScratchSize);
+  VkEventCreateInfo event_info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+  VkEvent go = VK_NULL_HANDLE;
+  Check(vkCreateEvent(gpu_.device(), &event_info, nullptr, &go), "vkCreateEvent");
+  VkCommandBuffer build = Record([&](VkCommandBuffer cb) {
+    vkCmdWaitEvents(cb, 1, &go, VK_PIPELINE_STAGE_HOST_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
+                    nullptr, 0, nullptr, 0, nullptr);
+    BuildInto(cb, ground, spare.handle, scratch.address);
+  });
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  Check(vkCreateFence(gpu_.device(), &fence_info, nullptr, &fence), "vkCreateFence");
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &build;
+  Check(vkQueueSubmit(gpu_.queue(), 1, &submit, fence), "vkQueueSubmit");
+  std::printf("fault: destroying the scratch buffer of a submitted build that has not run yet\n");
+  vkDestroyBuffer(gpu_.device(), scratch.buffer, nullptr);
+  scratch.buffer = VK_NULL_HANDLE;  // its memory is freed with the scratchpad, after the GPU is idle
+  Check(vkSetEvent(gpu_.device(), go), "vkSetEvent");
+  Check(vkWaitForFences(gpu_.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  vkDestroyFence(gpu_.device(), fence, nullptr);
+  vkDestroyEvent(gpu_.device(), go, nullptr);
+  gpu_.FreeCommandBuffer(build);
 }
 
 }  // namespace
