@@ -72,6 +72,8 @@ for line in open(os.path.join(out, "faults.txt")):
         if "when the work that broke the rule completed" in notice.get("message", ""):
             return "halt"
         function = notice.get("function", "")
+        if function.startswith(("vkDestroy", "vkFree")):
+            return "delayed"
         return "cmd" if function.startswith("vkCmd") else "submit" if function.startswith("vkQueue") else "host"
     kept = "+".join(kind(f) for f in findings if f.get("vuid") == "ASVAL-Protect-Withheld") or "-"
     rows.append((fault, vuid.replace("VUID-", ""), "yes" if hit else "no", kept, message))
@@ -86,7 +88,8 @@ print()
 print("%d of %d faults reported by asval with their exact VUID. 'no': asval has no check for that rule yet" % (detected, len(rows)))
 print("(docs/coverage.md lists what is checked). The scene's image: %s" % os.path.join(out, "scene.png"))
 print("withheld: what asval's protect mode kept from the driver (cmd: the command; submit: a submission; halt: the")
-print("fault ran, found when it completed, so later submissions are withheld; docs/protect.md).")
+print("fault ran, found when it completed, so later submissions are withheld; delayed: a destroy made once the work")
+print("using the object completed; docs/protect.md).")
 PY
 
 # The scene refits 2 structures per frame; engines refit hundreds (skinned characters, deforming props), often one

@@ -186,7 +186,7 @@ TEST_CASE(
 TEST_CASE(
     "lifetime valid twin: an alias of the input buffer over the same memory destroyed while the build is "
     "pending stays silent (the build's buffer still holds the address)",
-    "[integration][lifetime]") {
+    "[integration][lifetime][khronos-whole-submission]") {
   HistoryFixture f(nullptr, {}, TimelineDevice());
   vkkit::Device& device = f.device();
   Inputs inputs(device);
@@ -215,7 +215,7 @@ TEST_CASE(
 TEST_CASE(
     "lifetime valid twin: inputs destroyed once the host saw an event the device set after the build, while "
     "the rest of the submission is pending, stay silent",
-    "[integration][lifetime]") {
+    "[integration][lifetime][khronos-whole-submission]") {
   HistoryFixture f(nullptr, {}, TimelineDevice());
   vkkit::Device& device = f.device();
   auto inputs = std::make_unique<Inputs>(device);
