@@ -183,7 +183,6 @@ CORPUS_CASE(DestroyedReferenceByPointer, "host-instance-pointer-to-destroyed-bla
   vkkit::AccelerationStructure gone = device.CreateAccelerationStructure(kBottom, 256);
   VkAccelerationStructureInstanceKHR second = build.instance;
   second.accelerationStructureReference = reinterpret_cast<uint64_t>(gone.handle);
-  device.Destroy(gone);
   // The two instances and the array of pointers to them in mapped memory (see HostBuild::Call).
   struct Mapped {
     VkAccelerationStructureInstanceKHR instances[2];
@@ -199,6 +198,9 @@ CORPUS_CASE(DestroyedReferenceByPointer, "host-instance-pointer-to-destroyed-bla
   build.geometry.geometry.instances.data.hostAddress = m->pointers;
   build.range.primitiveCount = 2;
   scene.Prepare(build.info, {2});  // a destination sized for 2 instances
+  // Destroyed only now: a structure created after it (the destination above) could take its handle value (lavapipe's
+  // handles are heap addresses), and the reference would then name a live structure.
+  device.Destroy(gone);
   build.info.scratchData.hostAddress = build.scratch.data();
   build.Call(device);
   device.Destroy(mapped);
