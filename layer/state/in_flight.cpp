@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <new>
 
-#include "failure_injection.h"
+#include "layer_fences.h"
 
 namespace asval {
 
@@ -79,21 +79,7 @@ void InFlight::Abandon(std::vector<InFlightBatch>& staging) {
   staging.clear();
 }
 
-VkFence InFlight::TakeFence() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!free_fences_.empty()) {
-      VkFence f = free_fences_.back();
-      free_fences_.pop_back();
-      return f;
-    }
-  }
-  VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  if (InjectedFailure(FailSite::kLayerFence)) return VK_NULL_HANDLE;  // the test hook: as if vkCreateFence failed
-  if (!next_.CreateFence || next_.CreateFence(device_, &info, nullptr, &fence) != VK_SUCCESS) return VK_NULL_HANDLE;
-  return fence;
-}
+VkFence InFlight::TakeFence() { return TakeLayerFence(device_, next_, mutex_, free_fences_); }
 
 void InFlight::ReturnFence(VkFence fence) {
   if (fence) next_.DestroyFence(device_, fence, nullptr);
