@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "structure_memory.h"
@@ -104,6 +106,39 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
 
 namespace {
 
+// Where the object being destroyed or freed can be used: the device-address ranges of the buffers that go with it and
+// the structures created on them. A touched address outside every range, or an operation naming none of those
+// structures, cannot use it: no lookup is made for those (a destroy while thousands of builds are in flight walks
+// their addresses with a compare each).
+struct Going {
+  std::vector<std::pair<VkDeviceAddress, VkDeviceSize>> ranges;  // [base, base + size)
+  std::vector<VkAccelerationStructureKHR> structures;
+
+  bool Touches(VkDeviceAddress address) const {
+    for (const auto& [base, size] : ranges) {
+      if (address >= base && address - base < size) return true;
+    }
+    return false;
+  }
+  bool Names(VkAccelerationStructureKHR as) const {
+    return as && std::find(structures.begin(), structures.end(), as) != structures.end();
+  }
+  // Adds a buffer that goes: its addresses, and the structures created on it.
+  void Add(const CheckContext& ctx, const BufferState& buffer) {
+    if (buffer.device_address != 0) ranges.emplace_back(buffer.device_address, buffer.size);
+    if (!(buffer.usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR)) return;
+    const VkBuffer handle = buffer.handle;
+    const uint64_t id = buffer.id;
+    for (const auto& [as, record] : ctx.state.acceleration_structures.snapshot(
+             [&](VkAccelerationStructureKHR, const std::shared_ptr<const AccelerationStructureState>& s) {
+               return s && s->buffer == handle && s->buffer_id == id;
+             })) {
+      structures.push_back(as);
+    }
+  }
+  bool empty() const { return ranges.empty() && structures.empty(); }
+};
+
 // What a pending batch uses of the object being destroyed: the first operation found, and how.
 struct FoundUse {
   const AsOp* op = nullptr;
@@ -114,12 +149,13 @@ struct FoundUse {
 // structure's buffer) goes away with the object; a touched address is used only when every holder that stays...
 // none does and one goes.
 template <typename Goes>
-FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, Goes&& goes) {
+FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, const Going& going_away, Goes&& goes) {
   FoundUse found;
   for (const std::shared_ptr<const RecordedOps>& recorded : b.recorded) {
     if (!recorded) continue;
     const std::vector<AsOp>& ops = recorded->batch.ops();
     for (const AddressTouch& touch : recorded->batch.touches()) {
+      if (!going_away.Touches(touch.address)) continue;
       bool going = false, staying = false;
       ForEachHolder(ctx, touch.address, b.serial,
                     [&](const BufferState& holder) { (goes(holder) ? going : staying) = true; });
@@ -131,6 +167,7 @@ FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, Goes&& goes) 
     }
     for (const AsOp& op : ops) {
       for (VkAccelerationStructureKHR as : {op.src, op.dst}) {
+        if (!going_away.Names(as)) continue;
         const std::shared_ptr<const AccelerationStructureState> s = StructureOf(ctx, as, b.serial);
         if (!s) continue;
         const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, *s);
@@ -146,13 +183,14 @@ FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, Goes&& goes) 
 
 template <typename Goes>
 bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, const char* function,
-                ReportObject object, const char* what, Goes&& goes) {
+                ReportObject object, const char* what, const Going& going_away, Goes&& goes) {
+  if (going_away.empty()) return false;  // no address and no structure: nothing in flight can use it
   InFlightSkips skips;
   std::vector<std::string> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
-      [&](const InFlightBatch& b) { return FirstUse(ctx, b, goes).op != nullptr; },
+      [&](const InFlightBatch& b) { return FirstUse(ctx, b, going_away, goes).op != nullptr; },
       [&](const InFlightBatch& b) {
-        const FoundUse use = FirstUse(ctx, b, goes);
+        const FoundUse use = FirstUse(ctx, b, going_away, goes);
         if (!use.op) return;
         findings.push_back(fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
       },
@@ -170,9 +208,11 @@ bool CheckDestroyBufferInUse(const CheckContext& ctx, InFlight& in_flight, VkBuf
   std::optional<std::shared_ptr<const BufferState>> record = ctx.state.buffers.find(buffer);
   if (!record || !*record || !(*record)->bound) return false;
   const uint64_t id = (*record)->id;
+  Going going;
+  going.Add(ctx, **record);
   const std::string what = fmt::format("VkBuffer 0x{:x}", reinterpret_cast<uint64_t>(buffer));
   return CheckInUse(ctx, in_flight, kBufferInUse, "vkDestroyBuffer", Obj(VK_OBJECT_TYPE_BUFFER, buffer), what.c_str(),
-                    [&](const BufferState& holder) { return holder.id == id; });
+                    going, [&](const BufferState& holder) { return holder.id == id; });
 }
 
 bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDeviceMemory memory) {
@@ -185,8 +225,13 @@ bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDevice
                               "keeps it until that submission completes){}.",
                               what, reinterpret_cast<uint64_t>(kept), kNotDone));
   }
+  Going going;
+  for (const auto& [handle, b] : ctx.state.buffers.snapshot(
+           [&](VkBuffer, const std::shared_ptr<const BufferState>& s) { return s && s->bound && s->memory == memory; })) {
+    going.Add(ctx, *b);
+  }
   return CheckInUse(ctx, in_flight, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),
-                    what.c_str(), [&](const BufferState& holder) { return holder.memory == memory; });
+                    what.c_str(), going, [&](const BufferState& holder) { return holder.memory == memory; });
 }
 
 void ReportLifetimeSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {

@@ -183,7 +183,9 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   }
   // Pre-record: the batches that use structures, buffers or memory are staged as in flight (in_flight.h); without a
   // fence of the app's, the layer's own goes down in its place and tells when they completed.
-  std::vector<InFlightBatch> in_flight;
+  // This thread's staging array, kept with its capacity: a submission allocates nothing for it in the steady state
+  // (nothing between staging and Commit/Abandon submits on this thread).
+  thread_local std::vector<InFlightBatch> in_flight;
   VkFence in_flight_fence = VK_NULL_HANDLE;
   if (data.in_flight) {
     try {
