@@ -3,10 +3,13 @@
 // in every build it checks that each thread's findings arrive, no more and no fewer.
 #include <catch2/catch_test_macros.hpp>
 #include <atomic>
+#include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
 #include "fixture.h"
+#include "history_helpers.h"
 
 namespace asval_test {
 namespace {
@@ -47,6 +50,53 @@ TEST_CASE("concurrent recording on several threads", "[integration][threads]") {
           build.Release(device);
         }
         vkDestroyCommandPool(device.handle(), pool, nullptr);
+      } catch (...) {
+        ++failures;
+      }
+    });
+  }
+  for (std::thread& th : threads) th.join();
+  CHECK(failures == 0);
+  CHECK(f.monitor().Verify() == "");
+}
+
+
+TEST_CASE("threads submitting builds and destroying their inputs once their own fences signaled, while the others' "
+          "work is in flight, stay silent (lifetime)",
+          "[integration][threads][lifetime]") {
+  HistoryFixture f;
+  vkkit::Device& device = f.device();
+  constexpr int kThreads = 4;
+  constexpr int kRounds = 5;
+  std::mutex queue_mutex;  // the queue is externally synchronized
+  std::atomic<int> failures{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&] {
+      try {
+        Commands commands(device);
+        VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VkFence fence = VK_NULL_HANDLE;
+        vkkit::Check(vkCreateFence(device.handle(), &fence_info, nullptr, &fence), "fence");
+        for (int round = 0; round < kRounds; ++round) {
+          auto inputs = std::make_unique<Inputs>(device);
+          auto blas = std::make_unique<Blas>(device, *inputs);
+          const VkCommandBuffer cb = commands.Begin();
+          blas->Build(cb, Shape{});
+          commands.End(cb);
+          VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+          submit.commandBufferCount = 1;
+          submit.pCommandBuffers = &cb;
+          {
+            std::lock_guard<std::mutex> lock(queue_mutex);
+            vkkit::Check(vkQueueSubmit(device.queue(), 1, &submit, fence), "submit");
+          }
+          vkkit::Check(vkWaitForFences(device.handle(), 1, &fence, VK_TRUE, 10ull * 1000 * 1000 * 1000), "wait");
+          vkkit::Check(vkResetFences(device.handle(), 1, &fence), "reset");
+          blas.reset();  // its work completed: the structure, its buffers and the inputs go
+          inputs.reset();
+        }
+        vkDestroyFence(device.handle(), fence, nullptr);
       } catch (...) {
         ++failures;
       }
