@@ -48,7 +48,7 @@ CORPUS_CASE(InputDestroyedPending, "lifetime-input-buffer-destroyed-while-build-
   const VkFence fence = MakeFence(device);
   Submit(device, cb, fence);
   const vkkit::Buffer held = inputs->buffer();
-  (void)inputs.release();  // its VkBuffer is destroyed here, its memory freed once the build completed
+  inputs->Forget();  // its VkBuffer is destroyed here, its memory freed once the build completed
   vkDestroyBuffer(device.handle(), held.buffer, nullptr);
   vkkit::Check(vkSetEvent(device.handle(), go), "vkSetEvent");
   vkkit::Check(vkWaitForFences(device.handle(), 1, &fence, VK_TRUE, kTenSeconds), "vkWaitForFences");

@@ -110,6 +110,8 @@ class Inputs {
   VkDeviceAddress transform() const { return buffer_.address + kTransformOffset; }
   VkDeviceAddress aabbs() const { return buffer_.address + kAabbsOffset; }
   const vkkit::Buffer& buffer() const { return buffer_; }
+  // The test destroyed the buffer or freed the memory itself (lifetime tests): the destructor leaves them alone.
+  void Forget() { buffer_ = vkkit::Buffer{}; }
 
  private:
   vkkit::Device& device_;

@@ -36,7 +36,7 @@ TEST_CASE(
   f.monitor().Expect(kMemoryInUse);
   vkFreeMemory(device.handle(), held.memory, nullptr);
   CHECK(f.monitor().Verify() == "");
-  (void)inputs.release();  // destroyed above (the layer makes both calls once the build completed)
+  inputs->Forget();  // destroyed above (the layer makes both calls once the build completed)
   CHECK(gate.HostSignal(1) == VK_SUCCESS);
   CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
   CHECK(f.monitor().Verify() == "");

@@ -859,7 +859,7 @@ TEST_CASE("protect: a buffer destroyed while a pending build reads it is kept un
   const vkkit::Buffer held = inputs->buffer();
   vkDestroyBuffer(device.handle(), held.buffer, nullptr);  // kept back: the build still reads it
   vkFreeMemory(device.handle(), held.memory, nullptr);     // kept back too: the kept buffer is bound to it
-  (void)inputs.release();
+  inputs->Forget();
   CHECK(run.TakeFindings() == Strings{"VUID-vkDestroyBuffer-buffer-00922", "VUID-vkFreeMemory-memory-00677"});
   const Strings notices = run.TakeNotices();
   REQUIRE(notices.size() == 2);
