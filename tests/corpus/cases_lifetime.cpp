@@ -1,5 +1,7 @@
-// Family lifetime (issue 29): objects destroyed while submitted acceleration-structure work that uses them is
-// pending, and the engine patterns that destroy them validly (deferred deletion after a fence wait).
+// Family lifetime (issue 29): the engine patterns that destroy what acceleration-structure work used, validly
+// (deferred deletion after a fence wait). The fault itself is the scene's scratch-destroyed-while-pending: a corpus
+// case's callback skips the destroy a layer reports, and a layer that does not make it later (the Khronos layer)
+// leaks the buffer, which LeakSanitizer reports in the sanitizer build's corpus run.
 #include "corpus.h"
 #include "history_helpers.h"
 
@@ -29,33 +31,6 @@ void Submit(vkkit::Device& device, VkCommandBuffer cb, VkFence fence) {
 }
 
 }  // namespace
-
-CORPUS_CASE(InputDestroyedPending, "lifetime-input-buffer-destroyed-while-build-pending", "lifetime",
-            "a BLAS build waits for an event the host sets after it destroys the build's vertex VkBuffer (its memory "
-            "kept until the build completed, so the build stays safe)",
-            {"VUID-vkDestroyBuffer-buffer-00922"}) {
-  auto inputs = std::make_unique<Inputs>(device);
-  Blas blas(device, *inputs);
-  Commands commands(device);
-  VkEventCreateInfo event_info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
-  VkEvent go = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateEvent(device.handle(), &event_info, nullptr, &go), "vkCreateEvent");
-  VkCommandBuffer cb = commands.Begin();
-  vkCmdWaitEvents(cb, 1, &go, VK_PIPELINE_STAGE_HOST_BIT, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0,
-                  nullptr, 0, nullptr, 0, nullptr);
-  blas.Build(cb, Shape{});
-  commands.End(cb);
-  const VkFence fence = MakeFence(device);
-  Submit(device, cb, fence);
-  const vkkit::Buffer held = inputs->buffer();
-  inputs->Forget();  // its VkBuffer is destroyed here, its memory freed once the build completed
-  vkDestroyBuffer(device.handle(), held.buffer, nullptr);
-  vkkit::Check(vkSetEvent(device.handle(), go), "vkSetEvent");
-  vkkit::Check(vkWaitForFences(device.handle(), 1, &fence, VK_TRUE, kTenSeconds), "vkWaitForFences");
-  vkFreeMemory(device.handle(), held.memory, nullptr);
-  vkDestroyFence(device.handle(), fence, nullptr);
-  vkDestroyEvent(device.handle(), go, nullptr);
-}
 
 CORPUS_CASE(FramesInFlightDeferredDeletion, "lifetime-frames-in-flight-deferred-deletion", "patterns",
             "two frames in flight, each rebuilding the TLAS from its own new instance buffer; a frame's instance "
