@@ -88,7 +88,7 @@ VKAPI_ATTR VkResult VKAPI_CALL WaitForFences(VkDevice device, uint32_t fenceCoun
   const VkResult result = data->dispatch.WaitForFences(device, fenceCount, pFences, waitAll, timeout);
   if (result == VK_SUCCESS && data->in_flight) {
     if (waitAll || fenceCount == 1) {
-      data->in_flight->FencesSignaled(fenceCount, pFences, nullptr);
+      data->in_flight->FencesSignaled(fenceCount, pFences);
     } else {
       data->in_flight->Poll();  // waitAny: the fences that signaled are found by polling
     }
@@ -118,7 +118,7 @@ VKAPI_ATTR VkResult VKAPI_CALL GetFenceStatus(VkDevice device, VkFence fence) {
   covered.fences = &fence;
   covered.fence_count = 1;
   const VkResult result = data->dispatch.GetFenceStatus(device, fence);
-  if (result == VK_SUCCESS && data->in_flight) data->in_flight->FencesSignaled(1, &fence, nullptr);
+  if (result == VK_SUCCESS && data->in_flight) data->in_flight->FencesSignaled(1, &fence);
   return AfterWait(*data, result, covered);
 }
 

@@ -101,14 +101,14 @@ void InFlight::QueueIdle(VkQueue queue) {
   RetireCompleted();
 }
 
-void InFlight::FencesSignaled(uint32_t count, const VkFence* fences, const bool* signaled) {
+void InFlight::FencesSignaled(uint32_t count, const VkFence* fences) {
   if (Empty() || !fences) return;
   std::lock_guard<std::mutex> lock(mutex_);
   for (std::size_t k = batches_.size(); k-- > 0;) {
     const InFlightBatch& b = batches_[k];
     if (b.own_fence || !b.fence || b.complete) continue;
     for (uint32_t f = 0; f < count; ++f) {
-      if (fences[f] == b.fence && (!signaled || signaled[f])) {
+      if (fences[f] == b.fence) {
         CompleteUpTo(k);
         break;
       }

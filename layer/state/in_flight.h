@@ -82,9 +82,9 @@ class InFlight {
 
   // The app waited: every batch on `queue` (null: every queue) completed.
   void QueueIdle(VkQueue queue);
-  // The app's wait or poll of these fences returned VK_SUCCESS (fences[k] signaled when signaled[k], or all when
-  // signaled is null): their batches completed, and every earlier batch of their queues.
-  void FencesSignaled(uint32_t count, const VkFence* fences, const bool* signaled);
+  // The app's wait (waitAll) or poll of these fences returned VK_SUCCESS: their batches completed, and every earlier
+  // batch of their queues.
+  void FencesSignaled(uint32_t count, const VkFence* fences);
   // vkResetFences / vkDestroyFence: the app's fence no longer names its batches, which completed.
   void FenceRetired(VkFence fence);
   // vkDestroySemaphore: the batches that signal it completed (the app may destroy it only then), and the handle no
