@@ -38,6 +38,7 @@ void InitInstanceDispatchTable(VkInstance instance, PFN_vkGetInstanceProcAddr gi
 
 void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, DeviceDispatchTable* table) {
   table->AllocateCommandBuffers = reinterpret_cast<PFN_vkAllocateCommandBuffers>(gdpa(device, "vkAllocateCommandBuffers"));
+  table->AllocateDescriptorSets = reinterpret_cast<PFN_vkAllocateDescriptorSets>(gdpa(device, "vkAllocateDescriptorSets"));
   table->AllocateMemory = reinterpret_cast<PFN_vkAllocateMemory>(gdpa(device, "vkAllocateMemory"));
   table->BeginCommandBuffer = reinterpret_cast<PFN_vkBeginCommandBuffer>(gdpa(device, "vkBeginCommandBuffer"));
   table->BindBufferMemory = reinterpret_cast<PFN_vkBindBufferMemory>(gdpa(device, "vkBindBufferMemory"));
@@ -49,6 +50,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CmdBeginRenderPass2 = reinterpret_cast<PFN_vkCmdBeginRenderPass2>(LoadFirst(gdpa, device, kCmdBeginRenderPass2Names));
   static constexpr const char* kCmdBeginRenderingNames[] = {"vkCmdBeginRendering", "vkCmdBeginRenderingKHR"};
   table->CmdBeginRendering = reinterpret_cast<PFN_vkCmdBeginRendering>(LoadFirst(gdpa, device, kCmdBeginRenderingNames));
+  table->CmdBindDescriptorSets = reinterpret_cast<PFN_vkCmdBindDescriptorSets>(gdpa(device, "vkCmdBindDescriptorSets"));
   table->CmdBindPipeline = reinterpret_cast<PFN_vkCmdBindPipeline>(gdpa(device, "vkCmdBindPipeline"));
   table->CmdBuildAccelerationStructuresIndirectKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(gdpa(device, "vkCmdBuildAccelerationStructuresIndirectKHR"));
   table->CmdBuildAccelerationStructuresKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(gdpa(device, "vkCmdBuildAccelerationStructuresKHR"));
@@ -56,18 +58,25 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CmdCopyAccelerationStructureToMemoryKHR = reinterpret_cast<PFN_vkCmdCopyAccelerationStructureToMemoryKHR>(gdpa(device, "vkCmdCopyAccelerationStructureToMemoryKHR"));
   table->CmdCopyBuffer = reinterpret_cast<PFN_vkCmdCopyBuffer>(gdpa(device, "vkCmdCopyBuffer"));
   table->CmdCopyMemoryToAccelerationStructureKHR = reinterpret_cast<PFN_vkCmdCopyMemoryToAccelerationStructureKHR>(gdpa(device, "vkCmdCopyMemoryToAccelerationStructureKHR"));
+  table->CmdDispatch = reinterpret_cast<PFN_vkCmdDispatch>(gdpa(device, "vkCmdDispatch"));
   static constexpr const char* kCmdDispatchBaseNames[] = {"vkCmdDispatchBase", "vkCmdDispatchBaseKHR"};
   table->CmdDispatchBase = reinterpret_cast<PFN_vkCmdDispatchBase>(LoadFirst(gdpa, device, kCmdDispatchBaseNames));
+  table->CmdDispatchIndirect = reinterpret_cast<PFN_vkCmdDispatchIndirect>(gdpa(device, "vkCmdDispatchIndirect"));
   table->CmdExecuteCommands = reinterpret_cast<PFN_vkCmdExecuteCommands>(gdpa(device, "vkCmdExecuteCommands"));
   table->CmdPipelineBarrier = reinterpret_cast<PFN_vkCmdPipelineBarrier>(gdpa(device, "vkCmdPipelineBarrier"));
   static constexpr const char* kCmdPipelineBarrier2Names[] = {"vkCmdPipelineBarrier2", "vkCmdPipelineBarrier2KHR"};
   table->CmdPipelineBarrier2 = reinterpret_cast<PFN_vkCmdPipelineBarrier2>(LoadFirst(gdpa, device, kCmdPipelineBarrier2Names));
+  table->CmdPushDescriptorSetKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(gdpa(device, "vkCmdPushDescriptorSetKHR"));
+  table->CmdPushDescriptorSetWithTemplateKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetWithTemplateKHR>(gdpa(device, "vkCmdPushDescriptorSetWithTemplateKHR"));
   table->CmdResetEvent = reinterpret_cast<PFN_vkCmdResetEvent>(gdpa(device, "vkCmdResetEvent"));
   static constexpr const char* kCmdResetEvent2Names[] = {"vkCmdResetEvent2", "vkCmdResetEvent2KHR"};
   table->CmdResetEvent2 = reinterpret_cast<PFN_vkCmdResetEvent2>(LoadFirst(gdpa, device, kCmdResetEvent2Names));
   table->CmdSetEvent = reinterpret_cast<PFN_vkCmdSetEvent>(gdpa(device, "vkCmdSetEvent"));
   static constexpr const char* kCmdSetEvent2Names[] = {"vkCmdSetEvent2", "vkCmdSetEvent2KHR"};
   table->CmdSetEvent2 = reinterpret_cast<PFN_vkCmdSetEvent2>(LoadFirst(gdpa, device, kCmdSetEvent2Names));
+  table->CmdTraceRaysIndirect2KHR = reinterpret_cast<PFN_vkCmdTraceRaysIndirect2KHR>(gdpa(device, "vkCmdTraceRaysIndirect2KHR"));
+  table->CmdTraceRaysIndirectKHR = reinterpret_cast<PFN_vkCmdTraceRaysIndirectKHR>(gdpa(device, "vkCmdTraceRaysIndirectKHR"));
+  table->CmdTraceRaysKHR = reinterpret_cast<PFN_vkCmdTraceRaysKHR>(gdpa(device, "vkCmdTraceRaysKHR"));
   table->CmdWaitEvents = reinterpret_cast<PFN_vkCmdWaitEvents>(gdpa(device, "vkCmdWaitEvents"));
   static constexpr const char* kCmdWaitEvents2Names[] = {"vkCmdWaitEvents2", "vkCmdWaitEvents2KHR"};
   table->CmdWaitEvents2 = reinterpret_cast<PFN_vkCmdWaitEvents2>(LoadFirst(gdpa, device, kCmdWaitEvents2Names));
@@ -79,10 +88,14 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateBuffer = reinterpret_cast<PFN_vkCreateBuffer>(gdpa(device, "vkCreateBuffer"));
   table->CreateCommandPool = reinterpret_cast<PFN_vkCreateCommandPool>(gdpa(device, "vkCreateCommandPool"));
   table->CreateComputePipelines = reinterpret_cast<PFN_vkCreateComputePipelines>(gdpa(device, "vkCreateComputePipelines"));
+  table->CreateDescriptorSetLayout = reinterpret_cast<PFN_vkCreateDescriptorSetLayout>(gdpa(device, "vkCreateDescriptorSetLayout"));
+  static constexpr const char* kCreateDescriptorUpdateTemplateNames[] = {"vkCreateDescriptorUpdateTemplate", "vkCreateDescriptorUpdateTemplateKHR"};
+  table->CreateDescriptorUpdateTemplate = reinterpret_cast<PFN_vkCreateDescriptorUpdateTemplate>(LoadFirst(gdpa, device, kCreateDescriptorUpdateTemplateNames));
   table->CreateEvent = reinterpret_cast<PFN_vkCreateEvent>(gdpa(device, "vkCreateEvent"));
   table->CreateFence = reinterpret_cast<PFN_vkCreateFence>(gdpa(device, "vkCreateFence"));
   table->CreatePipelineLayout = reinterpret_cast<PFN_vkCreatePipelineLayout>(gdpa(device, "vkCreatePipelineLayout"));
   table->CreateQueryPool = reinterpret_cast<PFN_vkCreateQueryPool>(gdpa(device, "vkCreateQueryPool"));
+  table->CreateRayTracingPipelinesKHR = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(gdpa(device, "vkCreateRayTracingPipelinesKHR"));
   table->CreateSemaphore = reinterpret_cast<PFN_vkCreateSemaphore>(gdpa(device, "vkCreateSemaphore"));
   table->CreateShaderModule = reinterpret_cast<PFN_vkCreateShaderModule>(gdpa(device, "vkCreateShaderModule"));
   table->DeferredOperationJoinKHR = reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(gdpa(device, "vkDeferredOperationJoinKHR"));
@@ -90,6 +103,10 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->DestroyBuffer = reinterpret_cast<PFN_vkDestroyBuffer>(gdpa(device, "vkDestroyBuffer"));
   table->DestroyCommandPool = reinterpret_cast<PFN_vkDestroyCommandPool>(gdpa(device, "vkDestroyCommandPool"));
   table->DestroyDeferredOperationKHR = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(gdpa(device, "vkDestroyDeferredOperationKHR"));
+  table->DestroyDescriptorPool = reinterpret_cast<PFN_vkDestroyDescriptorPool>(gdpa(device, "vkDestroyDescriptorPool"));
+  table->DestroyDescriptorSetLayout = reinterpret_cast<PFN_vkDestroyDescriptorSetLayout>(gdpa(device, "vkDestroyDescriptorSetLayout"));
+  static constexpr const char* kDestroyDescriptorUpdateTemplateNames[] = {"vkDestroyDescriptorUpdateTemplate", "vkDestroyDescriptorUpdateTemplateKHR"};
+  table->DestroyDescriptorUpdateTemplate = reinterpret_cast<PFN_vkDestroyDescriptorUpdateTemplate>(LoadFirst(gdpa, device, kDestroyDescriptorUpdateTemplateNames));
   table->DestroyDevice = reinterpret_cast<PFN_vkDestroyDevice>(gdpa(device, "vkDestroyDevice"));
   table->DestroyEvent = reinterpret_cast<PFN_vkDestroyEvent>(gdpa(device, "vkDestroyEvent"));
   table->DestroyFence = reinterpret_cast<PFN_vkDestroyFence>(gdpa(device, "vkDestroyFence"));
@@ -101,6 +118,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->DeviceWaitIdle = reinterpret_cast<PFN_vkDeviceWaitIdle>(gdpa(device, "vkDeviceWaitIdle"));
   table->EndCommandBuffer = reinterpret_cast<PFN_vkEndCommandBuffer>(gdpa(device, "vkEndCommandBuffer"));
   table->FreeCommandBuffers = reinterpret_cast<PFN_vkFreeCommandBuffers>(gdpa(device, "vkFreeCommandBuffers"));
+  table->FreeDescriptorSets = reinterpret_cast<PFN_vkFreeDescriptorSets>(gdpa(device, "vkFreeDescriptorSets"));
   table->FreeMemory = reinterpret_cast<PFN_vkFreeMemory>(gdpa(device, "vkFreeMemory"));
   table->GetAccelerationStructureBuildSizesKHR = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(gdpa(device, "vkGetAccelerationStructureBuildSizesKHR"));
   table->GetAccelerationStructureDeviceAddressKHR = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(gdpa(device, "vkGetAccelerationStructureDeviceAddressKHR"));
@@ -127,11 +145,15 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->QueueWaitIdle = reinterpret_cast<PFN_vkQueueWaitIdle>(gdpa(device, "vkQueueWaitIdle"));
   table->ResetCommandBuffer = reinterpret_cast<PFN_vkResetCommandBuffer>(gdpa(device, "vkResetCommandBuffer"));
   table->ResetCommandPool = reinterpret_cast<PFN_vkResetCommandPool>(gdpa(device, "vkResetCommandPool"));
+  table->ResetDescriptorPool = reinterpret_cast<PFN_vkResetDescriptorPool>(gdpa(device, "vkResetDescriptorPool"));
   table->ResetFences = reinterpret_cast<PFN_vkResetFences>(gdpa(device, "vkResetFences"));
   table->SetDebugUtilsObjectNameEXT = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(gdpa(device, "vkSetDebugUtilsObjectNameEXT"));
   static constexpr const char* kSignalSemaphoreNames[] = {"vkSignalSemaphore", "vkSignalSemaphoreKHR"};
   table->SignalSemaphore = reinterpret_cast<PFN_vkSignalSemaphore>(LoadFirst(gdpa, device, kSignalSemaphoreNames));
   table->UnmapMemory = reinterpret_cast<PFN_vkUnmapMemory>(gdpa(device, "vkUnmapMemory"));
+  static constexpr const char* kUpdateDescriptorSetWithTemplateNames[] = {"vkUpdateDescriptorSetWithTemplate", "vkUpdateDescriptorSetWithTemplateKHR"};
+  table->UpdateDescriptorSetWithTemplate = reinterpret_cast<PFN_vkUpdateDescriptorSetWithTemplate>(LoadFirst(gdpa, device, kUpdateDescriptorSetWithTemplateNames));
+  table->UpdateDescriptorSets = reinterpret_cast<PFN_vkUpdateDescriptorSets>(gdpa(device, "vkUpdateDescriptorSets"));
   table->WaitForFences = reinterpret_cast<PFN_vkWaitForFences>(gdpa(device, "vkWaitForFences"));
   static constexpr const char* kWaitSemaphoresNames[] = {"vkWaitSemaphores", "vkWaitSemaphoresKHR"};
   table->WaitSemaphores = reinterpret_cast<PFN_vkWaitSemaphores>(LoadFirst(gdpa, device, kWaitSemaphoresNames));

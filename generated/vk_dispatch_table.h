@@ -26,6 +26,7 @@ struct InstanceDispatchTable {
 
 struct DeviceDispatchTable {
   PFN_vkAllocateCommandBuffers AllocateCommandBuffers = nullptr;
+  PFN_vkAllocateDescriptorSets AllocateDescriptorSets = nullptr;
   PFN_vkAllocateMemory AllocateMemory = nullptr;
   PFN_vkBeginCommandBuffer BeginCommandBuffer = nullptr;
   PFN_vkBindBufferMemory BindBufferMemory = nullptr;
@@ -34,6 +35,7 @@ struct DeviceDispatchTable {
   PFN_vkCmdBeginRenderPass CmdBeginRenderPass = nullptr;
   PFN_vkCmdBeginRenderPass2 CmdBeginRenderPass2 = nullptr;
   PFN_vkCmdBeginRendering CmdBeginRendering = nullptr;
+  PFN_vkCmdBindDescriptorSets CmdBindDescriptorSets = nullptr;
   PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR CmdBuildAccelerationStructuresIndirectKHR = nullptr;
   PFN_vkCmdBuildAccelerationStructuresKHR CmdBuildAccelerationStructuresKHR = nullptr;
@@ -41,14 +43,21 @@ struct DeviceDispatchTable {
   PFN_vkCmdCopyAccelerationStructureToMemoryKHR CmdCopyAccelerationStructureToMemoryKHR = nullptr;
   PFN_vkCmdCopyBuffer CmdCopyBuffer = nullptr;
   PFN_vkCmdCopyMemoryToAccelerationStructureKHR CmdCopyMemoryToAccelerationStructureKHR = nullptr;
+  PFN_vkCmdDispatch CmdDispatch = nullptr;
   PFN_vkCmdDispatchBase CmdDispatchBase = nullptr;
+  PFN_vkCmdDispatchIndirect CmdDispatchIndirect = nullptr;
   PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
   PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
   PFN_vkCmdPipelineBarrier2 CmdPipelineBarrier2 = nullptr;
+  PFN_vkCmdPushDescriptorSetKHR CmdPushDescriptorSetKHR = nullptr;
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR CmdPushDescriptorSetWithTemplateKHR = nullptr;
   PFN_vkCmdResetEvent CmdResetEvent = nullptr;
   PFN_vkCmdResetEvent2 CmdResetEvent2 = nullptr;
   PFN_vkCmdSetEvent CmdSetEvent = nullptr;
   PFN_vkCmdSetEvent2 CmdSetEvent2 = nullptr;
+  PFN_vkCmdTraceRaysIndirect2KHR CmdTraceRaysIndirect2KHR = nullptr;
+  PFN_vkCmdTraceRaysIndirectKHR CmdTraceRaysIndirectKHR = nullptr;
+  PFN_vkCmdTraceRaysKHR CmdTraceRaysKHR = nullptr;
   PFN_vkCmdWaitEvents CmdWaitEvents = nullptr;
   PFN_vkCmdWaitEvents2 CmdWaitEvents2 = nullptr;
   PFN_vkCmdWriteAccelerationStructuresPropertiesKHR CmdWriteAccelerationStructuresPropertiesKHR = nullptr;
@@ -59,10 +68,13 @@ struct DeviceDispatchTable {
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
   PFN_vkCreateComputePipelines CreateComputePipelines = nullptr;
+  PFN_vkCreateDescriptorSetLayout CreateDescriptorSetLayout = nullptr;
+  PFN_vkCreateDescriptorUpdateTemplate CreateDescriptorUpdateTemplate = nullptr;
   PFN_vkCreateEvent CreateEvent = nullptr;
   PFN_vkCreateFence CreateFence = nullptr;
   PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
+  PFN_vkCreateRayTracingPipelinesKHR CreateRayTracingPipelinesKHR = nullptr;
   PFN_vkCreateSemaphore CreateSemaphore = nullptr;
   PFN_vkCreateShaderModule CreateShaderModule = nullptr;
   PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
@@ -70,6 +82,9 @@ struct DeviceDispatchTable {
   PFN_vkDestroyBuffer DestroyBuffer = nullptr;
   PFN_vkDestroyCommandPool DestroyCommandPool = nullptr;
   PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
+  PFN_vkDestroyDescriptorPool DestroyDescriptorPool = nullptr;
+  PFN_vkDestroyDescriptorSetLayout DestroyDescriptorSetLayout = nullptr;
+  PFN_vkDestroyDescriptorUpdateTemplate DestroyDescriptorUpdateTemplate = nullptr;
   PFN_vkDestroyDevice DestroyDevice = nullptr;
   PFN_vkDestroyEvent DestroyEvent = nullptr;
   PFN_vkDestroyFence DestroyFence = nullptr;
@@ -81,6 +96,7 @@ struct DeviceDispatchTable {
   PFN_vkDeviceWaitIdle DeviceWaitIdle = nullptr;
   PFN_vkEndCommandBuffer EndCommandBuffer = nullptr;
   PFN_vkFreeCommandBuffers FreeCommandBuffers = nullptr;
+  PFN_vkFreeDescriptorSets FreeDescriptorSets = nullptr;
   PFN_vkFreeMemory FreeMemory = nullptr;
   PFN_vkGetAccelerationStructureBuildSizesKHR GetAccelerationStructureBuildSizesKHR = nullptr;
   PFN_vkGetAccelerationStructureDeviceAddressKHR GetAccelerationStructureDeviceAddressKHR = nullptr;
@@ -103,10 +119,13 @@ struct DeviceDispatchTable {
   PFN_vkQueueWaitIdle QueueWaitIdle = nullptr;
   PFN_vkResetCommandBuffer ResetCommandBuffer = nullptr;
   PFN_vkResetCommandPool ResetCommandPool = nullptr;
+  PFN_vkResetDescriptorPool ResetDescriptorPool = nullptr;
   PFN_vkResetFences ResetFences = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT SetDebugUtilsObjectNameEXT = nullptr;
   PFN_vkSignalSemaphore SignalSemaphore = nullptr;
   PFN_vkUnmapMemory UnmapMemory = nullptr;
+  PFN_vkUpdateDescriptorSetWithTemplate UpdateDescriptorSetWithTemplate = nullptr;
+  PFN_vkUpdateDescriptorSets UpdateDescriptorSets = nullptr;
   PFN_vkWaitForFences WaitForFences = nullptr;
   PFN_vkWaitSemaphores WaitSemaphores = nullptr;
   PFN_vkWriteAccelerationStructuresPropertiesKHR WriteAccelerationStructuresPropertiesKHR = nullptr;

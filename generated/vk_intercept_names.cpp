@@ -7,6 +7,7 @@ namespace asval::hooks {
 
 const char* const kInterceptNames[kInterceptNameCount] = {
     "vkAllocateCommandBuffers",
+    "vkAllocateDescriptorSets",
     "vkAllocateMemory",
     "vkBeginCommandBuffer",
     "vkBindBufferMemory",
@@ -18,22 +19,32 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdBeginRenderPass2KHR",
     "vkCmdBeginRendering",
     "vkCmdBeginRenderingKHR",
+    "vkCmdBindDescriptorSets",
     "vkCmdBindPipeline",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
     "vkCmdBuildAccelerationStructuresKHR",
     "vkCmdCopyAccelerationStructureKHR",
     "vkCmdCopyAccelerationStructureToMemoryKHR",
     "vkCmdCopyMemoryToAccelerationStructureKHR",
+    "vkCmdDispatch",
+    "vkCmdDispatchBase",
+    "vkCmdDispatchBaseKHR",
+    "vkCmdDispatchIndirect",
     "vkCmdExecuteCommands",
     "vkCmdPipelineBarrier",
     "vkCmdPipelineBarrier2",
     "vkCmdPipelineBarrier2KHR",
+    "vkCmdPushDescriptorSetKHR",
+    "vkCmdPushDescriptorSetWithTemplateKHR",
     "vkCmdResetEvent",
     "vkCmdResetEvent2",
     "vkCmdResetEvent2KHR",
     "vkCmdSetEvent",
     "vkCmdSetEvent2",
     "vkCmdSetEvent2KHR",
+    "vkCmdTraceRaysIndirect2KHR",
+    "vkCmdTraceRaysIndirectKHR",
+    "vkCmdTraceRaysKHR",
     "vkCmdWaitEvents",
     "vkCmdWaitEvents2",
     "vkCmdWaitEvents2KHR",
@@ -44,25 +55,38 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateAccelerationStructureKHR",
     "vkCreateBuffer",
     "vkCreateCommandPool",
+    "vkCreateComputePipelines",
     "vkCreateDebugUtilsMessengerEXT",
+    "vkCreateDescriptorSetLayout",
+    "vkCreateDescriptorUpdateTemplate",
+    "vkCreateDescriptorUpdateTemplateKHR",
     "vkCreateDevice",
     "vkCreateInstance",
     "vkCreateQueryPool",
+    "vkCreateRayTracingPipelinesKHR",
     "vkCreateSemaphore",
+    "vkCreateShaderModule",
     "vkDeferredOperationJoinKHR",
     "vkDestroyAccelerationStructureKHR",
     "vkDestroyBuffer",
     "vkDestroyCommandPool",
     "vkDestroyDebugUtilsMessengerEXT",
     "vkDestroyDeferredOperationKHR",
+    "vkDestroyDescriptorPool",
+    "vkDestroyDescriptorSetLayout",
+    "vkDestroyDescriptorUpdateTemplate",
+    "vkDestroyDescriptorUpdateTemplateKHR",
     "vkDestroyDevice",
     "vkDestroyFence",
     "vkDestroyInstance",
+    "vkDestroyPipeline",
     "vkDestroyQueryPool",
     "vkDestroySemaphore",
+    "vkDestroyShaderModule",
     "vkDeviceWaitIdle",
     "vkEndCommandBuffer",
     "vkFreeCommandBuffers",
+    "vkFreeDescriptorSets",
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
     "vkGetDeviceBufferMemoryRequirements",
@@ -81,11 +105,15 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkQueueWaitIdle",
     "vkResetCommandBuffer",
     "vkResetCommandPool",
+    "vkResetDescriptorPool",
     "vkResetFences",
     "vkSetDebugUtilsObjectNameEXT",
     "vkSignalSemaphore",
     "vkSignalSemaphoreKHR",
     "vkUnmapMemory",
+    "vkUpdateDescriptorSetWithTemplate",
+    "vkUpdateDescriptorSetWithTemplateKHR",
+    "vkUpdateDescriptorSets",
     "vkWaitForFences",
     "vkWaitSemaphores",
     "vkWaitSemaphoresKHR",
@@ -94,6 +122,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
 
 const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkAllocateCommandBuffers
+    true,  // vkAllocateDescriptorSets
     true,  // vkAllocateMemory
     true,  // vkBeginCommandBuffer
     true,  // vkBindBufferMemory
@@ -105,22 +134,32 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdBeginRenderPass2KHR
     true,  // vkCmdBeginRendering
     true,  // vkCmdBeginRenderingKHR
+    true,  // vkCmdBindDescriptorSets
     true,  // vkCmdBindPipeline
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
     true,  // vkCmdBuildAccelerationStructuresKHR
     true,  // vkCmdCopyAccelerationStructureKHR
     true,  // vkCmdCopyAccelerationStructureToMemoryKHR
     true,  // vkCmdCopyMemoryToAccelerationStructureKHR
+    true,  // vkCmdDispatch
+    true,  // vkCmdDispatchBase
+    true,  // vkCmdDispatchBaseKHR
+    true,  // vkCmdDispatchIndirect
     true,  // vkCmdExecuteCommands
     true,  // vkCmdPipelineBarrier
     true,  // vkCmdPipelineBarrier2
     true,  // vkCmdPipelineBarrier2KHR
+    true,  // vkCmdPushDescriptorSetKHR
+    true,  // vkCmdPushDescriptorSetWithTemplateKHR
     true,  // vkCmdResetEvent
     true,  // vkCmdResetEvent2
     true,  // vkCmdResetEvent2KHR
     true,  // vkCmdSetEvent
     true,  // vkCmdSetEvent2
     true,  // vkCmdSetEvent2KHR
+    true,  // vkCmdTraceRaysIndirect2KHR
+    true,  // vkCmdTraceRaysIndirectKHR
+    true,  // vkCmdTraceRaysKHR
     true,  // vkCmdWaitEvents
     true,  // vkCmdWaitEvents2
     true,  // vkCmdWaitEvents2KHR
@@ -131,25 +170,38 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCreateAccelerationStructureKHR
     true,  // vkCreateBuffer
     true,  // vkCreateCommandPool
+    true,  // vkCreateComputePipelines
     false,  // vkCreateDebugUtilsMessengerEXT
+    true,  // vkCreateDescriptorSetLayout
+    true,  // vkCreateDescriptorUpdateTemplate
+    true,  // vkCreateDescriptorUpdateTemplateKHR
     false,  // vkCreateDevice
     false,  // vkCreateInstance
     true,  // vkCreateQueryPool
+    true,  // vkCreateRayTracingPipelinesKHR
     true,  // vkCreateSemaphore
+    true,  // vkCreateShaderModule
     true,  // vkDeferredOperationJoinKHR
     true,  // vkDestroyAccelerationStructureKHR
     true,  // vkDestroyBuffer
     true,  // vkDestroyCommandPool
     false,  // vkDestroyDebugUtilsMessengerEXT
     true,  // vkDestroyDeferredOperationKHR
+    true,  // vkDestroyDescriptorPool
+    true,  // vkDestroyDescriptorSetLayout
+    true,  // vkDestroyDescriptorUpdateTemplate
+    true,  // vkDestroyDescriptorUpdateTemplateKHR
     true,  // vkDestroyDevice
     true,  // vkDestroyFence
     false,  // vkDestroyInstance
+    true,  // vkDestroyPipeline
     true,  // vkDestroyQueryPool
     true,  // vkDestroySemaphore
+    true,  // vkDestroyShaderModule
     true,  // vkDeviceWaitIdle
     true,  // vkEndCommandBuffer
     true,  // vkFreeCommandBuffers
+    true,  // vkFreeDescriptorSets
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR
     true,  // vkGetDeviceBufferMemoryRequirements
@@ -168,11 +220,15 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkQueueWaitIdle
     true,  // vkResetCommandBuffer
     true,  // vkResetCommandPool
+    true,  // vkResetDescriptorPool
     true,  // vkResetFences
     true,  // vkSetDebugUtilsObjectNameEXT
     true,  // vkSignalSemaphore
     true,  // vkSignalSemaphoreKHR
     true,  // vkUnmapMemory
+    true,  // vkUpdateDescriptorSetWithTemplate
+    true,  // vkUpdateDescriptorSetWithTemplateKHR
+    true,  // vkUpdateDescriptorSets
     true,  // vkWaitForFences
     true,  // vkWaitSemaphores
     true,  // vkWaitSemaphoresKHR

@@ -7,7 +7,7 @@
 
 namespace asval::hooks {
 
-inline constexpr std::size_t kInterceptNameCount = 84;
+inline constexpr std::size_t kInterceptNameCount = 112;
 
 // Sorted by strcmp, no duplicates.
 extern const char* const kInterceptNames[kInterceptNameCount];

@@ -8,6 +8,12 @@ namespace asval {
 namespace {
 
 constexpr VuidInfo kVuids[] = {
+    {"VUID-RuntimeSpirv-OpRayQueryInitializeKHR-06352",
+     "For OpRayQueryInitializeKHR instructions, Acceleration Structure must be an acceleration structure built as a top-level acceleration structure",
+     "VUID-RuntimeSpirv-OpRayQueryInitializeKHR-06352"},
+    {"VUID-RuntimeSpirv-OpTraceRayKHR-06359",
+     "For OpTraceRayKHR instructions, Acceleration Structure must be an acceleration structure built as a top-level acceleration structure",
+     "VUID-RuntimeSpirv-OpTraceRayKHR-06359"},
     {"VUID-VkAabbPositionsKHR-minX-03546",
      "minX must be less than or equal to maxX",
      "VUID-VkAabbPositionsKHR-minX-03546"},

@@ -71,6 +71,7 @@ class Device {
   Device& operator=(const Device&) = delete;
 
   VkDevice handle() const { return device_; }
+  VkPhysicalDevice physical_device() const { return gpu_; }
   VkQueue queue() const { return queue_; }
   // Queue i of the chosen family (0: queue()); as many as DeviceOptions::queue_count and the family allow.
   VkQueue queue(uint32_t i) const { return queues_.at(i); }

@@ -4,6 +4,7 @@
 
 #include "build_report.h"
 #include "layer_settings.h"
+#include "traced_structures.h"
 #include "vk_enum_string.h"
 
 namespace asval {
@@ -314,6 +315,9 @@ void CheckOpHistory(const DeviceState& state, const HistoryStore& store, uint32_
       break;  // what it restores is decided when it is applied (history_apply.cpp)
     case OpKind::kWriteProperties:
       if (history) CheckPropertySource(r);
+      break;
+    case OpKind::kTrace:
+      if (enabled_checks & kCheckTraces) CheckTracedStructures(state, store, batch, op, site, out);
       break;
   }
 }

@@ -4,6 +4,7 @@
 #include "capture_saves.h"
 #include "history_recorder.h"
 #include "layer_data.h"
+#include "ray_recorder.h"
 #include "vk_intercepts.h"
 
 namespace asval::hooks {
@@ -101,6 +102,7 @@ VKAPI_ATTR void VKAPI_CALL CmdExecuteCommands(VkCommandBuffer commandBuffer, uin
   }
   // Protect mode: a secondary holding a withheld command marks the primary (a single load until one is marked).
   data->state.command_buffers.InheritWithheld(commandBuffer, commandBufferCount, pCommandBuffers);
+  RecordExecuteForTraces(data->state, commandBuffer);  // the primary's bindings are undefined now
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdBindPipeline(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,
@@ -111,6 +113,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBindPipeline(VkCommandBuffer commandBuffer, VkPipe
   if (pipelineBindPoint == VK_PIPELINE_BIND_POINT_COMPUTE && data->capture_pool && data->capture_pool->dispatches()) {
     RecordBindComputePipeline(data->state, commandBuffer, pipeline);
   }
+  RecordBindPipelineForTraces(data->state, commandBuffer, pipelineBindPoint, pipeline);
 }
 
 }  // namespace asval::hooks

@@ -12,6 +12,7 @@
 #include "protect_notices.h"
 #include "protect_scope.h"
 #include "state_tracker.h"
+#include "traced_structures.h"
 #include "vk_struct_chain.h"
 #include "vk_intercepts.h"
 
@@ -62,6 +63,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice device, const VkAllocationCall
     ReportProtectSummary(data->state, *data->reporter, device);
     ReportHistorySummary(data->state, *data->reporter, device);
     ReportLifetimeSummary(data->state, *data->reporter, device);
+    ReportTracesSummary(data->state, *data->reporter, device);
   }
   if (data) data->reporter->ForgetObjectNames(device);  // its queues' and its objects' left undestroyed
   if (data && data->dispatch.DestroyDevice) data->dispatch.DestroyDevice(device, pAllocator);

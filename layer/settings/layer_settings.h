@@ -51,7 +51,7 @@ struct LayerSettings {
 
   bool Reports(LayerSettingFlagBits severity) const { return (report_flags & severity) != 0; }
   // A family that needs the recorded operations is enabled (history, copies for dst-03561, lifetime).
-  bool TracksHistory() const { return (enabled_checks & (kCheckHistory | kCheckCopies | kCheckLifetime)) != 0; }
+  bool TracksHistory() const { return (enabled_checks & (kCheckHistory | kCheckCopies | kCheckLifetime | kCheckTraces)) != 0; }
 
   friend bool operator==(const LayerSettings& a, const LayerSettings& b) {
     bool same = true;

@@ -21,6 +21,12 @@ const char* OpCommandName(OpCommand command) {
     case OpCommand::kHostCopyMemoryTo: return "vkCopyMemoryToAccelerationStructureKHR";
     case OpCommand::kCmdWriteProperties: return "vkCmdWriteAccelerationStructuresPropertiesKHR";
     case OpCommand::kHostWriteProperties: return "vkWriteAccelerationStructuresPropertiesKHR";
+    case OpCommand::kCmdTraceRays: return "vkCmdTraceRaysKHR";
+    case OpCommand::kCmdTraceRaysIndirect: return "vkCmdTraceRaysIndirectKHR";
+    case OpCommand::kCmdTraceRaysIndirect2: return "vkCmdTraceRaysIndirect2KHR";
+    case OpCommand::kCmdDispatch: return "vkCmdDispatch";
+    case OpCommand::kCmdDispatchIndirect: return "vkCmdDispatchIndirect";
+    case OpCommand::kCmdDispatchBase: return "vkCmdDispatchBase";
     case OpCommand::kCount: break;
   }
   return "?";
@@ -84,6 +90,7 @@ void OpBatch::Clear() {
   ops_.clear();
   geometries_.clear();
   touches_.clear();
+  traced_.clear();
   applied_snapshots_.clear();
   lost_ = false;
 }
@@ -203,6 +210,16 @@ const char* TouchRoleName(TouchRole role) {
   return "address";
 }
 
+void OpBatch::AppendTrace(const OpOrigin& origin, const TracedBinding* bindings, uint32_t count) {
+  AsOp op;
+  op.kind = OpKind::kTrace;
+  op.origin = origin;
+  op.first_geometry = static_cast<uint32_t>(traced_.size());
+  op.geometry_count = count;
+  if (count != 0) std::memcpy(traced_.Extend(count), bindings, count * sizeof(TracedBinding));
+  ops_.push_back(op);
+}
+
 void OpBatch::Append(const AsOp& op) {
   ops_.push_back(op);
   if ((op.kind == OpKind::kSerialize || op.kind == OpKind::kDeserialize) && op.memory.device_address != 0 &&
@@ -267,9 +284,11 @@ void OpBatch::AppendExecuted(const OpBatch& secondary, VkCommandBuffer primary) 
     touches_.push_back(touch);
   }
   const uint32_t base = static_cast<uint32_t>(geometries_.size());
+  const uint32_t traced_base = static_cast<uint32_t>(traced_.size());
   geometries_.insert(geometries_.end(), secondary.geometries_.begin(), secondary.geometries_.end());
+  for (const TracedBinding& traced : secondary.traced_) traced_.push_back(traced);
   for (AsOp op : secondary.ops_) {
-    op.first_geometry += base;
+    op.first_geometry += op.kind == OpKind::kTrace ? traced_base : base;
     // A secondary executed inside another secondary keeps the outermost primary that ran it.
     op.origin.executed_by = primary;
     ops_.push_back(op);

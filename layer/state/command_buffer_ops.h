@@ -36,6 +36,13 @@ enum class OpCommand : uint8_t {
   kHostCopyMemoryTo,
   kCmdWriteProperties,
   kHostWriteProperties,
+  // Trace and ray-query work (OpKind::kTrace): the commands whose bound pipeline reads structure descriptors.
+  kCmdTraceRays,
+  kCmdTraceRaysIndirect,
+  kCmdTraceRaysIndirect2,
+  kCmdDispatch,
+  kCmdDispatchIndirect,
+  kCmdDispatchBase,
   kCount
 };
 constexpr std::size_t kOpCommandCount = static_cast<std::size_t>(OpCommand::kCount);
@@ -93,6 +100,7 @@ enum class OpKind : uint8_t {
   kSerialize,        // src into memory
   kDeserialize,      // memory into dst
   kWriteProperties,  // a property query of dst
+  kTrace,            // a trace or dispatch reading the structures of its bound descriptors (OpBatch::traced)
 };
 
 // Where serialized bytes live: device memory (resolved through the address map when recorded) or host memory.
@@ -140,8 +148,8 @@ struct AsOp {
   // kBuild
   VkBuildAccelerationStructureFlagsKHR flags = 0;
   VkAccelerationStructureTypeKHR type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  uint32_t geometry_count = 0;
-  uint32_t first_geometry = 0;  // index into the batch's geometries
+  uint32_t geometry_count = 0;   // kTrace: how many of the batch's traced bindings are its own
+  uint32_t first_geometry = 0;  // index into the batch's geometries; kTrace: into its traced bindings
   // The bytes this build read, captured when it executes (issue 12): capture_info is its index in
   // capture_log->infos; capture_log is null when the build was not captured. The log is kept alive by the
   // published recording that holds this operation (RecordedOps::capture_logs). kSerialize / kDeserialize of
@@ -179,6 +187,28 @@ struct AddressTouch {
   TouchRole role;
 };
 static_assert(std::is_trivial_v<AddressTouch>, "grown by a memset, written in place");
+
+// A structure binding that a trace or dispatch reads (issue 29, family traces): which descriptor the pipeline bound
+// then names there. Sets are looked up when the command is submitted (a set updated after binding, as
+// UPDATE_AFTER_BIND allows, is read as it is then); pushed descriptors are copied when pushed.
+enum class TracedSource : uint8_t {
+  kSet,         // `set`, bound at set number set_index
+  kPushed,      // `pushed` (with its serial), pushed with vkCmdPushDescriptorSetKHR
+  kNotBound,    // nothing bound at that set number (or that binding was not pushed)
+  kUnknown,     // pushed with a template, or the pipeline reads descriptor buffers: not followed
+};
+// The instruction that reads the binding, for the rule's VUID.
+enum class TracedBy : uint8_t { kTraceRay, kRayQuery };
+struct TracedBinding {
+  uint32_t set_index;
+  uint32_t binding;
+  TracedSource source;
+  TracedBy by;
+  VkDescriptorSet set;
+  VkAccelerationStructureKHR pushed;
+  uint64_t pushed_serial;  // AccelerationStructureState::serial when pushed (0: unknown)
+};
+static_assert(std::is_trivial_v<TracedBinding>, "copied as bytes");
 
 // A growable array of trivial records that grows without writing them (std::vector value-initializes what it
 // adds), for arrays written in place by the caller. Keeps its capacity across Clear.
@@ -239,6 +269,8 @@ class OpBatch {
   const std::vector<GeometryRecord>& geometries() const { return geometries_; }
   // The device addresses the operations read or write (scratch, geometry inputs, serialized bytes).
   const TrivialArray<AddressTouch>& touches() const { return touches_; }
+  // The structure bindings of the kTrace operations (each names its own by first_geometry / geometry_count).
+  const TrivialArray<TracedBinding>& traced() const { return traced_; }
   const GeometryRecord* GeometriesOf(const AsOp& op) const { return geometries_.data() + op.first_geometry; }
   bool empty() const { return ops_.empty(); }
   // The operations could not all be recorded (an allocation failed: host commands, history_recorder.cpp): what
@@ -252,6 +284,7 @@ class OpBatch {
     ops_.swap(other.ops_);
     geometries_.swap(other.geometries_);
     touches_.swap(other.touches_);
+    traced_.swap(other.traced_);
     applied_snapshots_.swap(other.applied_snapshots_);
     std::swap(lost_, other.lost_);
   }
@@ -277,6 +310,8 @@ class OpBatch {
                     const VkAccelerationStructureBuildRangeInfoKHR* const* ranges,
                     CaptureLog* log = nullptr, const uint32_t* captured = nullptr, uint64_t max_geometry_count = 0,
                     bool touches = true);
+  // A trace or dispatch reading `count` structure bindings (kTrace).
+  void AppendTrace(const OpOrigin& origin, const TracedBinding* bindings, uint32_t count);
   // Any other operation (no geometries); device serialization and deserialization touch their bytes.
   void Append(const AsOp& op);
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.
@@ -300,6 +335,7 @@ class OpBatch {
 
   std::vector<GeometryRecord> geometries_;
   TrivialArray<AddressTouch> touches_;
+  TrivialArray<TracedBinding> traced_;
   mutable std::vector<std::shared_ptr<const BuildSnapshot>> applied_snapshots_;
   bool lost_ = false;
 };

@@ -31,6 +31,7 @@ void CommandBufferState::Reset() {
   capture_run.Close();  // its reservations were in that log
   executed_capture_logs.clear();
   compute_pipeline = VK_NULL_HANDLE;
+  bound_structures.Reset();
   simultaneous_use = false;
   calls_.fill(0);
   std::shared_ptr<const RecordedOps> old;

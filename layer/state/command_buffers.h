@@ -19,6 +19,7 @@
 #include <mutex>
 #include <vector>
 
+#include "bound_structures.h"
 #include "capture_log.h"
 #include "capture_run.h"
 #include "command_buffer_ops.h"
@@ -64,6 +65,8 @@ class CommandBufferState {
   // after the layer's reducing dispatch. Null: none bound yet in this recording, or the binding became undefined
   // (vkCmdExecuteCommands).
   VkPipeline compute_pipeline = VK_NULL_HANDLE;
+  // Family traces: the pipelines, sets and pushed structures bound for trace and ray-query work.
+  BoundStructures bound_structures;
   // Begun with VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT: executions of this recording may overlap, so its
   // capture points do not wait on events (one execution's set could release another's wait).
   bool simultaneous_use = false;

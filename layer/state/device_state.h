@@ -3,6 +3,7 @@
 // live objects the acceleration-structure rules need, in sharded maps that any thread may read.
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "live_structure_addresses.h"
 #include "objects.h"
 #include "protect_marks.h"
+#include "ray_bindings.h"
 
 namespace asval {
 
@@ -62,6 +64,9 @@ class DeviceState {
   // Family lifetime is on: device builds keep the addresses they read and write (OpBatch::touches), which the
   // in-flight checks look up when an object is destroyed (layer/checks/lifetime.h).
   bool lifetime_tracked = true;
+  // Family traces is on: the structures that trace and ray-query work binds are followed (ray_bindings.h), and each
+  // trace or dispatch reading them is judged at submission (layer/checks/traced_structures.h).
+  bool traces_tracked = true;
   // With capture = all, degenerate instances (the degenerate_instance capture warning, info severity) or instance
   // translations (the float_spacing capture warning) are judged: each captured top-level build keeps the activity
   // of every live structure as of its submission.
@@ -108,6 +113,14 @@ class DeviceState {
     std::atomic<uint64_t> skipped_host_may_know{0};  // batches the host may know complete before their fence
   };
   mutable LifetimeCounters lifetime_counters;
+  // Family traces: the structures judged at submission, and why others were not (TracedSkip order).
+  struct TraceCounters {
+    std::atomic<uint64_t> judged{0};
+    std::array<std::atomic<uint64_t>, 6> skipped{};
+  };
+  mutable TraceCounters trace_counters;
+  // Shader modules, pipelines, layouts, templates and descriptor sets that hold acceleration structures.
+  RayBindings ray_bindings;
   // Calls protect mode kept from the driver, and whether an error judged at completion halted submissions
   // (protect_marks.h).
   ProtectCounters protect_counters;

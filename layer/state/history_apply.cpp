@@ -484,6 +484,7 @@ void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch
     case OpKind::kSerialize: ApplySerialize(store, op, txn, captures); break;
     case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn, captures); break;
     case OpKind::kWriteProperties: ApplyWriteProperties(store, op, txn); break;
+    case OpKind::kTrace: break;  // reads structures only (judged before: layer/checks/traced_structures.h)
   }
 }
 

@@ -1,0 +1,149 @@
+#include "traced_structures.h"
+
+#include <fmt/format.h>
+
+#include <string>
+
+#include "build_report.h"
+
+namespace asval {
+
+namespace {
+
+constexpr const char kTraceRayBuilt[] = "VUID-RuntimeSpirv-OpTraceRayKHR-06359";
+constexpr const char kRayQueryBuilt[] = "VUID-RuntimeSpirv-OpRayQueryInitializeKHR-06352";
+
+struct TracedJudge {
+  const DeviceState& state;
+  const HistoryStore& store;
+  const AsOp& op;
+  const HistoryCheckSite& site;
+  HistoryFindings& out;
+
+  void Skip(TracedSkip why) const {
+    state.trace_counters.skipped[static_cast<std::size_t>(why)].fetch_add(1, std::memory_order_relaxed);
+  }
+
+  // Where the structure came from, for the message.
+  static std::string Through(const TracedBinding& b) {
+    if (b.source == TracedSource::kPushed) {
+      return fmt::format("pushed at set {} binding {}", b.set_index, b.binding);
+    }
+    return fmt::format("through VkDescriptorSet {} bound at set {}, binding {}", Hex(b.set), b.set_index, b.binding);
+  }
+
+  void Judge(const TracedBinding& b, const DescribedStructure& d) const {
+    if (d.as == VK_NULL_HANDLE) return;  // a null descriptor (nullDescriptor): nothing is read
+    if (d.serial == 0) return Skip(TracedSkip::kUnknownStructure);
+    const std::optional<std::shared_ptr<const AccelerationStructureState>> now =
+        state.acceleration_structures.find(d.as);
+    if (!now || !*now || (*now)->serial != d.serial) return Skip(TracedSkip::kDestroyed);
+    const AsHistory* h = store.Find(d.as);  // a live structure without a record was never built
+    if (h && h->kind == HistoryKind::kUnknown) {
+      store.rules_skipped_unknown_history.fetch_add(1, std::memory_order_relaxed);
+      return Skip(TracedSkip::kUnknownHistory);
+    }
+    state.trace_counters.judged.fetch_add(1, std::memory_order_relaxed);
+    const bool built = h && h->kind == HistoryKind::kBuilt && h->build;
+    if (built && h->build->type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return;
+    Report(b, d.as, built ? h : nullptr);
+  }
+
+  // built_bottom: the history of a structure whose last build made a bottom-level one; null: never built.
+  [[gnu::cold, gnu::noinline]] void Report(const TracedBinding& b, VkAccelerationStructureKHR as,
+                                           const AsHistory* built_bottom) const {
+    const bool trace = b.by == TracedBy::kTraceRay;
+    const char* instruction = trace ? "OpTraceRayKHR" : "OpRayQueryInitializeKHR";
+    const std::string what = built_bottom
+                                 ? fmt::format("the build that last executed on it ({}) made a bottom-level structure",
+                                               DescribeOrigin(built_bottom->build->origin))
+                                 : std::string("no build has executed on it before this command, in submission order");
+    out.Add(Severity::kError, trace ? kTraceRayBuilt : kRayQueryBuilt, site.loc,
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, as),
+             Obj(VK_OBJECT_TYPE_DESCRIPTOR_SET, b.source == TracedSource::kSet ? b.set : VK_NULL_HANDLE)},
+            fmt::format("{}: the bound pipeline's shaders read VkAccelerationStructureKHR {} ({}) and use {}, which "
+                        "needs a structure built as a top-level acceleration structure; {}. Build it (or rewrite "
+                        "the descriptor) before this command executes.",
+                        DescribeOrigin(op.origin), Hex(as), Through(b), instruction, what));
+  }
+};
+
+}  // namespace
+
+const char* TracedSkipName(TracedSkip skip) {
+  switch (skip) {
+    case TracedSkip::kNotBound:
+      return "not_bound";
+    case TracedSkip::kNotWritten:
+      return "not_written";
+    case TracedSkip::kUnreadable:
+      return "unreadable_descriptors";
+    case TracedSkip::kUnknownStructure:
+      return "unknown_structure";
+    case TracedSkip::kDestroyed:
+      return "destroyed";
+    case TracedSkip::kUnknownHistory:
+      return "unknown_history";
+    case TracedSkip::kCount:
+      break;
+  }
+  return "?";
+}
+
+void CheckTracedStructures(const DeviceState& state, const HistoryStore& store, const OpBatch& batch, const AsOp& op,
+                           const HistoryCheckSite& site, HistoryFindings& out) {
+  const TracedJudge judge{state, store, op, site, out};
+  const TracedBinding* bindings = batch.traced().begin() + op.first_geometry;
+  for (uint32_t i = 0; i < op.geometry_count; ++i) {
+    const TracedBinding& b = bindings[i];
+    switch (b.source) {
+      case TracedSource::kNotBound:
+        judge.Skip(TracedSkip::kNotBound);
+        break;
+      case TracedSource::kUnknown:
+        judge.Skip(TracedSkip::kUnreadable);
+        break;
+      case TracedSource::kPushed:
+        judge.Judge(b, DescribedStructure{b.pushed, b.pushed_serial});
+        break;
+      case TracedSource::kSet: {
+        const SetLookup found =
+            state.ray_bindings.ForEachIn(b.set, b.binding, [&](const DescribedStructure& d) { judge.Judge(b, d); });
+        if (found == SetLookup::kNotWritten) judge.Skip(TracedSkip::kNotWritten);
+        if (found == SetLookup::kUnknown) judge.Skip(TracedSkip::kUnreadable);
+        break;
+      }
+    }
+  }
+}
+
+void ReportTracesSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
+  const DeviceState::TraceCounters& c = state.trace_counters;
+  constexpr std::size_t kReasons = static_cast<std::size_t>(TracedSkip::kCount);
+  static_assert(kReasons == std::tuple_size_v<decltype(c.skipped)>, "one counter per reason");
+  NamedCount reasons[kReasons];
+  uint64_t skipped = 0;
+  for (std::size_t i = 0; i < kReasons; ++i) {
+    reasons[i] = NamedCount{TracedSkipName(static_cast<TracedSkip>(i)), c.skipped[i].load(std::memory_order_relaxed)};
+    skipped += reasons[i].count;
+  }
+  const uint64_t judged = c.judged.load(std::memory_order_relaxed);
+  if (judged + skipped == 0) return;
+  std::string text = fmt::format(
+      "Structures traced (traces): {} structures read by trace and ray-query commands were judged at submission; not "
+      "judged:",
+      judged);
+  for (const NamedCount& r : reasons) text += fmt::format(" {}={}", r.name, r.count);
+  text +=
+      ". Structures a shader reaches from a device address (OpConvertUToAccelerationStructureKHR) and ray queries in "
+      "draws are not followed.";
+  const NamedCounts counts{"traces_skipped", reasons, kReasons};
+  const Location where("vkDestroyDevice");
+  if (skipped != 0) {
+    reporter.ReportUnchecked(kTracesSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);
+  } else {
+    reporter.Report(Severity::kInfo, kTracesSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);
+  }
+}
+
+}  // namespace asval

@@ -1,0 +1,230 @@
+// Trace and ray-query work (family traces, issue 29): the shader modules and pipelines that read acceleration-structure
+// descriptors, the descriptors written into sets, the sets bound, and the traces and dispatches that read them
+// (layer/state/ray_recorder.h). Each is passed down unchanged first; the layer records what succeeded. Destroys are
+// recorded before the downcall: afterwards another thread may be handed the same handle value.
+#include "layer_data.h"
+#include "ray_recorder.h"
+#include "vk_intercepts.h"
+
+namespace asval::hooks {
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateShaderModule(VkDevice device, const VkShaderModuleCreateInfo* pCreateInfo,
+                                                  const VkAllocationCallbacks* pAllocator,
+                                                  VkShaderModule* pShaderModule) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateShaderModule(device, pCreateInfo, pAllocator, pShaderModule);
+  if (result == VK_SUCCESS && pCreateInfo) RecordCreateShaderModule(data->state, *pCreateInfo, *pShaderModule);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyShaderModule(VkDevice device, VkShaderModule shaderModule,
+                                               const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  RecordDestroyShaderModule(data->state, shaderModule);
+  data->dispatch.DestroyShaderModule(device, shaderModule, pAllocator);
+}
+
+// A creation that fails may still have created some pipelines (VK_PIPELINE_COMPILE_REQUIRED and others leave the
+// rest VK_NULL_HANDLE): every non-null handle is kept.
+VKAPI_ATTR VkResult VKAPI_CALL CreateComputePipelines(VkDevice device, VkPipelineCache pipelineCache,
+                                                      uint32_t createInfoCount,
+                                                      const VkComputePipelineCreateInfo* pCreateInfos,
+                                                      const VkAllocationCallbacks* pAllocator, VkPipeline* pPipelines) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateComputePipelines(device, pipelineCache, createInfoCount, pCreateInfos,
+                                                                pAllocator, pPipelines);
+  if (result >= VK_SUCCESS) RecordCreateComputePipelines(data->state, createInfoCount, pCreateInfos, pPipelines);
+  return result;
+}
+
+// A deferred creation (VK_OPERATION_DEFERRED_KHR) writes its handles when the operation completes: not followed.
+VKAPI_ATTR VkResult VKAPI_CALL CreateRayTracingPipelinesKHR(VkDevice device, VkDeferredOperationKHR deferredOperation,
+                                                            VkPipelineCache pipelineCache, uint32_t createInfoCount,
+                                                            const VkRayTracingPipelineCreateInfoKHR* pCreateInfos,
+                                                            const VkAllocationCallbacks* pAllocator,
+                                                            VkPipeline* pPipelines) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateRayTracingPipelinesKHR(
+      device, deferredOperation, pipelineCache, createInfoCount, pCreateInfos, pAllocator, pPipelines);
+  if (result == VK_SUCCESS || result == VK_PIPELINE_COMPILE_REQUIRED) {
+    RecordCreateRayTracingPipelines(data->state, createInfoCount, pCreateInfos, pPipelines);
+  }
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyPipeline(VkDevice device, VkPipeline pipeline,
+                                           const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  RecordDestroyPipeline(data->state, pipeline);
+  data->dispatch.DestroyPipeline(device, pipeline, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateDescriptorSetLayout(VkDevice device,
+                                                         const VkDescriptorSetLayoutCreateInfo* pCreateInfo,
+                                                         const VkAllocationCallbacks* pAllocator,
+                                                         VkDescriptorSetLayout* pSetLayout) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateDescriptorSetLayout(device, pCreateInfo, pAllocator, pSetLayout);
+  if (result == VK_SUCCESS && pCreateInfo) RecordCreateDescriptorSetLayout(data->state, *pCreateInfo, *pSetLayout);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyDescriptorSetLayout(VkDevice device, VkDescriptorSetLayout descriptorSetLayout,
+                                                      const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  RecordDestroyDescriptorSetLayout(data->state, descriptorSetLayout);
+  data->dispatch.DestroyDescriptorSetLayout(device, descriptorSetLayout, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreateDescriptorUpdateTemplate(VkDevice device,
+                                                              const VkDescriptorUpdateTemplateCreateInfo* pCreateInfo,
+                                                              const VkAllocationCallbacks* pAllocator,
+                                                              VkDescriptorUpdateTemplate* pDescriptorUpdateTemplate) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result =
+      data->dispatch.CreateDescriptorUpdateTemplate(device, pCreateInfo, pAllocator, pDescriptorUpdateTemplate);
+  if (result == VK_SUCCESS && pCreateInfo) {
+    RecordCreateDescriptorUpdateTemplate(data->state, *pCreateInfo, *pDescriptorUpdateTemplate);
+  }
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyDescriptorUpdateTemplate(VkDevice device,
+                                                           VkDescriptorUpdateTemplate descriptorUpdateTemplate,
+                                                           const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  RecordDestroyDescriptorUpdateTemplate(data->state, descriptorUpdateTemplate);
+  data->dispatch.DestroyDescriptorUpdateTemplate(device, descriptorUpdateTemplate, pAllocator);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL AllocateDescriptorSets(VkDevice device, const VkDescriptorSetAllocateInfo* pAllocateInfo,
+                                                      VkDescriptorSet* pDescriptorSets) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.AllocateDescriptorSets(device, pAllocateInfo, pDescriptorSets);
+  if (result == VK_SUCCESS && pAllocateInfo) RecordAllocateDescriptorSets(data->state, *pAllocateInfo, pDescriptorSets);
+  return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL FreeDescriptorSets(VkDevice device, VkDescriptorPool descriptorPool,
+                                                  uint32_t descriptorSetCount, const VkDescriptorSet* pDescriptorSets) {
+  DeviceData* data = GetDeviceData(device);
+  RecordFreeDescriptorSets(data->state, descriptorSetCount, pDescriptorSets);
+  return data->dispatch.FreeDescriptorSets(device, descriptorPool, descriptorSetCount, pDescriptorSets);
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL ResetDescriptorPool(VkDevice device, VkDescriptorPool descriptorPool,
+                                                   VkDescriptorPoolResetFlags flags) {
+  DeviceData* data = GetDeviceData(device);
+  RecordResetDescriptorPool(data->state, descriptorPool);
+  return data->dispatch.ResetDescriptorPool(device, descriptorPool, flags);
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyDescriptorPool(VkDevice device, VkDescriptorPool descriptorPool,
+                                                 const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  if (descriptorPool) RecordResetDescriptorPool(data->state, descriptorPool);
+  data->dispatch.DestroyDescriptorPool(device, descriptorPool, pAllocator);
+}
+
+VKAPI_ATTR void VKAPI_CALL UpdateDescriptorSets(VkDevice device, uint32_t descriptorWriteCount,
+                                                const VkWriteDescriptorSet* pDescriptorWrites,
+                                                uint32_t descriptorCopyCount,
+                                                const VkCopyDescriptorSet* pDescriptorCopies) {
+  DeviceData* data = GetDeviceData(device);
+  data->dispatch.UpdateDescriptorSets(device, descriptorWriteCount, pDescriptorWrites, descriptorCopyCount,
+                                      pDescriptorCopies);
+  RecordUpdateDescriptorSets(data->state, descriptorWriteCount, pDescriptorWrites, descriptorCopyCount,
+                             pDescriptorCopies);
+}
+
+VKAPI_ATTR void VKAPI_CALL UpdateDescriptorSetWithTemplate(VkDevice device, VkDescriptorSet descriptorSet,
+                                                           VkDescriptorUpdateTemplate descriptorUpdateTemplate,
+                                                           const void* pData) {
+  DeviceData* data = GetDeviceData(device);
+  data->dispatch.UpdateDescriptorSetWithTemplate(device, descriptorSet, descriptorUpdateTemplate, pData);
+  RecordUpdateDescriptorSetWithTemplate(data->state, descriptorSet, descriptorUpdateTemplate, pData);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdBindDescriptorSets(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,
+                                                 VkPipelineLayout layout, uint32_t firstSet,
+                                                 uint32_t descriptorSetCount, const VkDescriptorSet* pDescriptorSets,
+                                                 uint32_t dynamicOffsetCount, const uint32_t* pDynamicOffsets) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdBindDescriptorSets(commandBuffer, pipelineBindPoint, layout, firstSet, descriptorSetCount,
+                                       pDescriptorSets, dynamicOffsetCount, pDynamicOffsets);
+  RecordBindDescriptorSets(data->state, commandBuffer, pipelineBindPoint, firstSet, descriptorSetCount,
+                           pDescriptorSets);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdPushDescriptorSetKHR(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,
+                                                   VkPipelineLayout layout, uint32_t set, uint32_t descriptorWriteCount,
+                                                   const VkWriteDescriptorSet* pDescriptorWrites) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdPushDescriptorSetKHR(commandBuffer, pipelineBindPoint, layout, set, descriptorWriteCount,
+                                         pDescriptorWrites);
+  RecordPushDescriptorSet(data->state, commandBuffer, pipelineBindPoint, set, descriptorWriteCount, pDescriptorWrites);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdPushDescriptorSetWithTemplateKHR(VkCommandBuffer commandBuffer,
+                                                               VkDescriptorUpdateTemplate descriptorUpdateTemplate,
+                                                               VkPipelineLayout layout, uint32_t set,
+                                                               const void* pData) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdPushDescriptorSetWithTemplateKHR(commandBuffer, descriptorUpdateTemplate, layout, set, pData);
+  RecordPushDescriptorSetWithTemplate(data->state, commandBuffer, set);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDispatch(VkCommandBuffer commandBuffer, uint32_t groupCountX, uint32_t groupCountY,
+                                       uint32_t groupCountZ) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDispatch(commandBuffer, groupCountX, groupCountY, groupCountZ);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDispatch);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDispatchIndirect(VkCommandBuffer commandBuffer, VkBuffer buffer, VkDeviceSize offset) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDispatchIndirect(commandBuffer, buffer, offset);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDispatchIndirect);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDispatchBase(VkCommandBuffer commandBuffer, uint32_t baseGroupX, uint32_t baseGroupY,
+                                           uint32_t baseGroupZ, uint32_t groupCountX, uint32_t groupCountY,
+                                           uint32_t groupCountZ) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDispatchBase(commandBuffer, baseGroupX, baseGroupY, baseGroupZ, groupCountX, groupCountY,
+                                 groupCountZ);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDispatchBase);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdTraceRaysKHR(VkCommandBuffer commandBuffer,
+                                           const VkStridedDeviceAddressRegionKHR* pRaygenShaderBindingTable,
+                                           const VkStridedDeviceAddressRegionKHR* pMissShaderBindingTable,
+                                           const VkStridedDeviceAddressRegionKHR* pHitShaderBindingTable,
+                                           const VkStridedDeviceAddressRegionKHR* pCallableShaderBindingTable,
+                                           uint32_t width, uint32_t height, uint32_t depth) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdTraceRaysKHR(commandBuffer, pRaygenShaderBindingTable, pMissShaderBindingTable,
+                                 pHitShaderBindingTable, pCallableShaderBindingTable, width, height, depth);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdTraceRays);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdTraceRaysIndirectKHR(VkCommandBuffer commandBuffer,
+                                                   const VkStridedDeviceAddressRegionKHR* pRaygenShaderBindingTable,
+                                                   const VkStridedDeviceAddressRegionKHR* pMissShaderBindingTable,
+                                                   const VkStridedDeviceAddressRegionKHR* pHitShaderBindingTable,
+                                                   const VkStridedDeviceAddressRegionKHR* pCallableShaderBindingTable,
+                                                   VkDeviceAddress indirectDeviceAddress) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdTraceRaysIndirectKHR(commandBuffer, pRaygenShaderBindingTable, pMissShaderBindingTable,
+                                         pHitShaderBindingTable, pCallableShaderBindingTable, indirectDeviceAddress);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdTraceRaysIndirect);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdTraceRaysIndirect2KHR(VkCommandBuffer commandBuffer,
+                                                    VkDeviceAddress indirectDeviceAddress) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdTraceRaysIndirect2KHR(commandBuffer, indirectDeviceAddress);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdTraceRaysIndirect2);
+}
+
+}  // namespace asval::hooks

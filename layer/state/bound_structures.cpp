@@ -1,0 +1,101 @@
+#include "bound_structures.h"
+
+namespace asval {
+
+namespace {
+
+template <typename T>
+T& At(std::vector<T>& v, uint32_t i) {
+  if (v.size() <= i) v.resize(std::size_t{i} + 1, T{});
+  return v[i];
+}
+
+TracedBinding Row(const SetBinding& b, TracedSource source, TracedBy by) {
+  TracedBinding row;
+  row.set_index = b.set;
+  row.binding = b.binding;
+  row.source = source;
+  row.by = by;
+  row.set = VK_NULL_HANDLE;
+  row.pushed = VK_NULL_HANDLE;
+  row.pushed_serial = 0;
+  return row;
+}
+
+}  // namespace
+
+void BoundStructures::BindSets(Point point, uint32_t first_set, uint32_t count, const VkDescriptorSet* sets) {
+  Bound& b = bound_[point];
+  for (uint32_t i = 0; sets && i < count; ++i) {
+    At(b.sets, first_set + i) = sets[i];
+    if (first_set + i < b.pushed_sets.size()) b.pushed_sets[first_set + i] = PushState::kNone;
+  }
+}
+
+void BoundStructures::BeginPush(Point point, uint32_t set) {
+  Bound& b = bound_[point];
+  if (set < b.sets.size()) b.sets[set] = VK_NULL_HANDLE;
+  PushState& state = At(b.pushed_sets, set);
+  if (state != PushState::kNone) {
+    std::vector<Pushed>& p = b.pushed;
+    std::size_t kept = 0;
+    for (const Pushed& entry : p) {
+      if (entry.set != set) p[kept++] = entry;
+    }
+    p.resize(kept);
+  }
+  state = PushState::kKnown;
+}
+
+void BoundStructures::Push(Point point, uint32_t set, uint32_t binding, uint32_t element,
+                           const DescribedStructure& structure) {
+  Bound& b = bound_[point];
+  for (Pushed& entry : b.pushed) {
+    if (entry.set == set && entry.binding == binding && entry.element == element) {
+      entry.structure = structure;
+      return;
+    }
+  }
+  b.pushed.push_back(Pushed{set, binding, element, structure});
+}
+
+void BoundStructures::PushUnknown(Point point, uint32_t set) {
+  BeginPush(point, set);
+  bound_[point].pushed_sets[set] = PushState::kUnknown;
+}
+
+void BoundStructures::MakeTraced(Point point, bool traces, std::vector<TracedBinding>& out) const {
+  const Bound& b = bound_[point];
+  if (!b.pipeline) return;
+  const ShaderStructureUse& use = b.pipeline->use;
+  // A trace command's pipeline reads its structures through OpTraceRayKHR when it has one; ray queries otherwise.
+  const TracedBy by = traces && use.traces ? TracedBy::kTraceRay : TracedBy::kRayQuery;
+  for (const SetBinding& sb : use.bindings) {
+    if (b.pipeline->descriptor_buffers) {
+      out.push_back(Row(sb, TracedSource::kUnknown, by));
+      continue;
+    }
+    const PushState pushed = sb.set < b.pushed_sets.size() ? b.pushed_sets[sb.set] : PushState::kNone;
+    if (pushed == PushState::kUnknown) {
+      out.push_back(Row(sb, TracedSource::kUnknown, by));
+    } else if (pushed == PushState::kKnown) {
+      bool any = false;
+      for (const Pushed& entry : b.pushed) {
+        if (entry.set != sb.set || entry.binding != sb.binding) continue;
+        TracedBinding row = Row(sb, TracedSource::kPushed, by);
+        row.pushed = entry.structure.as;
+        row.pushed_serial = entry.structure.serial;
+        out.push_back(row);
+        any = true;
+      }
+      if (!any) out.push_back(Row(sb, TracedSource::kNotBound, by));
+    } else {
+      const VkDescriptorSet set = sb.set < b.sets.size() ? b.sets[sb.set] : VK_NULL_HANDLE;
+      TracedBinding row = Row(sb, set != VK_NULL_HANDLE ? TracedSource::kSet : TracedSource::kNotBound, by);
+      row.set = set;
+      out.push_back(row);
+    }
+  }
+}
+
+}  // namespace asval

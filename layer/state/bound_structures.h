@@ -1,0 +1,69 @@
+#pragma once
+// What a command buffer's recording has bound for trace and ray-query work (issue 29, family traces): per bind
+// point (compute, ray tracing), the pipeline when it reads structure descriptors, the descriptor sets bound at each
+// set number and the structures pushed there. Written by the recording thread only (CommandBufferState); tracked
+// only while some pipeline of the device reads structures (RayBindings::any_pipeline). A trace or dispatch turns it
+// into the TracedBinding records of its kTrace operation (MakeTraced).
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "command_buffer_ops.h"
+#include "ray_bindings.h"
+
+namespace asval {
+
+class BoundStructures {
+ public:
+  enum Point : uint8_t { kCompute, kRayTracing, kPointCount };
+  // The point of a bind point the family follows; kPointCount for graphics (draws are not followed).
+  static Point PointOf(VkPipelineBindPoint bind_point) {
+    if (bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return kCompute;
+    if (bind_point == VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR) return kRayTracing;
+    return kPointCount;
+  }
+
+  void Reset() {
+    for (Bound& b : bound_) {
+      b.pipeline.reset();
+      b.sets.clear();
+      b.pushed.clear();
+      b.pushed_sets.clear();
+    }
+  }
+  void BindPipeline(Point point, std::shared_ptr<const PipelineStructureUse> pipeline) {
+    bound_[point].pipeline = std::move(pipeline);
+  }
+  void BindSets(Point point, uint32_t first_set, uint32_t count, const VkDescriptorSet* sets);
+  // vkCmdPushDescriptorSetKHR: the structures written; `known` false for a push the layer could not read (a
+  // template, an unknown chain): that set number is then not followed until bound again.
+  void Push(Point point, uint32_t set, uint32_t binding, uint32_t element, const DescribedStructure& structure);
+  void PushUnknown(Point point, uint32_t set);
+  // Starting a push at `set` replaces what was bound or pushed there before.
+  void BeginPush(Point point, uint32_t set);
+  // vkCmdExecuteCommands: the bindings of the primary are undefined afterwards.
+  void Forget() { Reset(); }
+
+  // The pipeline bound at `point` when it reads structures (null otherwise).
+  const PipelineStructureUse* pipeline(Point point) const { return bound_[point].pipeline.get(); }
+  // The traced bindings of a trace (`traces`: a vkCmdTraceRays* command) or dispatch at `point`, appended to out.
+  void MakeTraced(Point point, bool traces, std::vector<TracedBinding>& out) const;
+
+ private:
+  struct Pushed {
+    uint32_t set, binding, element;
+    DescribedStructure structure;
+  };
+  enum class PushState : uint8_t { kNone, kKnown, kUnknown };
+  struct Bound {
+    std::shared_ptr<const PipelineStructureUse> pipeline;
+    std::vector<VkDescriptorSet> sets;  // by set number (VK_NULL_HANDLE: none)
+    std::vector<Pushed> pushed;
+    std::vector<PushState> pushed_sets;  // by set number
+  };
+  std::array<Bound, kPointCount> bound_;
+};
+
+}  // namespace asval

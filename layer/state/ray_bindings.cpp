@@ -1,0 +1,143 @@
+#include "ray_bindings.h"
+
+namespace asval {
+
+namespace {
+
+bool MayHoldStructures(VkDescriptorType type) {
+  return type == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR || type == VK_DESCRIPTOR_TYPE_MUTABLE_EXT;
+}
+
+}  // namespace
+
+void RayBindings::AddModule(VkShaderModule module, const std::optional<ShaderStructureUse>& use) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  modules_[module] = use;
+}
+
+void RayBindings::ForgetModule(VkShaderModule module) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  modules_.erase(module);
+}
+
+std::optional<ShaderStructureUse> RayBindings::Module(VkShaderModule module) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto found = modules_.find(module);
+  return found == modules_.end() ? std::nullopt : found->second;
+}
+
+void RayBindings::AddPipeline(VkPipeline pipeline, std::shared_ptr<const PipelineStructureUse> use) {
+  if (pipelines_.insert_or_assign(pipeline, std::move(use))) pipeline_count_.fetch_add(1, std::memory_order_acq_rel);
+}
+
+void RayBindings::ForgetPipeline(VkPipeline pipeline) {
+  if (!any_pipeline()) return;
+  if (pipelines_.erase(pipeline)) pipeline_count_.fetch_sub(1, std::memory_order_acq_rel);
+}
+
+void RayBindings::AddLayout(const VkDescriptorSetLayoutCreateInfo& info, VkDescriptorSetLayout layout) {
+  auto bindings = std::make_shared<StructureBindings>();
+  for (uint32_t i = 0; info.pBindings && i < info.bindingCount; ++i) {
+    const VkDescriptorSetLayoutBinding& b = info.pBindings[i];
+    if (MayHoldStructures(b.descriptorType)) (*bindings)[b.binding] = b.descriptorCount;
+  }
+  if (bindings->empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  layouts_[layout] = std::move(bindings);
+  Track();
+}
+
+void RayBindings::ForgetLayout(VkDescriptorSetLayout layout) {
+  if (idle()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  layouts_.erase(layout);
+}
+
+void RayBindings::AddTemplate(const VkDescriptorUpdateTemplateCreateInfo& info,
+                              VkDescriptorUpdateTemplate update_template) {
+  if (info.templateType != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET) return;  // push templates: per command
+  std::vector<TemplateEntry> entries;
+  for (uint32_t i = 0; info.pDescriptorUpdateEntries && i < info.descriptorUpdateEntryCount; ++i) {
+    const VkDescriptorUpdateTemplateEntry& e = info.pDescriptorUpdateEntries[i];
+    if (e.descriptorType != VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) continue;
+    entries.push_back(TemplateEntry{e.dstBinding, e.dstArrayElement, e.descriptorCount, e.offset, e.stride});
+  }
+  if (entries.empty()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  templates_[update_template] = std::move(entries);
+  Track();
+}
+
+void RayBindings::ForgetTemplate(VkDescriptorUpdateTemplate update_template) {
+  if (idle()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  templates_.erase(update_template);
+}
+
+void RayBindings::Allocate(const VkDescriptorSetAllocateInfo& info, const VkDescriptorSet* sets) {
+  if (idle() || !sets) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (uint32_t i = 0; info.pSetLayouts && i < info.descriptorSetCount; ++i) {
+    sets_.erase(sets[i]);  // a reused handle: the old set is gone
+    const auto layout = layouts_.find(info.pSetLayouts[i]);
+    if (layout == layouts_.end()) continue;
+    SetRecord& record = sets_[sets[i]];
+    record.pool = info.descriptorPool;
+    record.bindings = layout->second;
+  }
+}
+
+void RayBindings::Free(uint32_t count, const VkDescriptorSet* sets) {
+  if (idle() || !sets) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (uint32_t i = 0; i < count; ++i) sets_.erase(sets[i]);
+}
+
+void RayBindings::ResetPool(VkDescriptorPool pool) {
+  if (idle()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto it = sets_.begin(); it != sets_.end();) {
+    it = it->second.pool == pool ? sets_.erase(it) : std::next(it);
+  }
+}
+
+void RayBindings::WriteStructures(VkDescriptorSet set, uint32_t binding, uint32_t element,
+                                  const std::vector<DescribedStructure>& structures) {
+  SetRecord& record = sets_[set];
+  if (!record.bindings) return MarkUnknown(set);  // a set the layer saw allocated with no structure binding
+  const auto count = record.bindings->find(binding);
+  if (count == record.bindings->end() || element + uint64_t{structures.size()} > count->second) {
+    return MarkUnknown(set);  // continues into the next binding: not followed
+  }
+  for (std::size_t i = 0; i < structures.size(); ++i) {
+    record.slots[Slot(binding, element + static_cast<uint32_t>(i))] = structures[i];
+  }
+}
+
+void RayBindings::MarkUnknown(VkDescriptorSet set) {
+  SetRecord& record = sets_[set];
+  record.unknown = true;
+  record.slots.clear();
+}
+
+void RayBindings::CopyLocked(const VkCopyDescriptorSet& copy) {
+  const auto src = sets_.find(copy.srcSet);
+  const auto dst = sets_.find(copy.dstSet);
+  if (src == sets_.end() && dst == sets_.end()) return;  // neither holds structures
+  if (dst != sets_.end() && dst->second.bindings && !dst->second.bindings->count(copy.dstBinding))
+    return;  // another type
+  if (src == sets_.end() || src->second.unknown) return MarkUnknown(copy.dstSet);
+  std::vector<DescribedStructure> structures(copy.descriptorCount);
+  for (uint32_t i = 0; i < copy.descriptorCount; ++i) {
+    const auto slot = src->second.slots.find(Slot(copy.srcBinding, copy.srcArrayElement + i));
+    if (slot != src->second.slots.end()) structures[i] = slot->second;
+  }
+  WriteStructures(copy.dstSet, copy.dstBinding, copy.dstArrayElement, structures);
+}
+
+std::size_t RayBindings::set_count() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return sets_.size();
+}
+
+}  // namespace asval

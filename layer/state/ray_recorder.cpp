@@ -1,0 +1,237 @@
+#include "ray_recorder.h"
+
+#include <new>
+
+namespace asval {
+
+namespace {
+
+// The serial of a live structure (0: the layer does not know it).
+uint64_t SerialOf(const DeviceState& state, VkAccelerationStructureKHR as) {
+  const std::optional<std::shared_ptr<const AccelerationStructureState>> found = state.acceleration_structures.find(as);
+  return found && *found ? (*found)->serial : 0;
+}
+
+// What one pipeline stage reads: its module's scan, or the code chained in its create info (a module created with
+// the pipeline); nullopt when neither is known (a module identifier, a module the layer never saw).
+std::optional<ShaderStructureUse> StageUse(const DeviceState& state, const VkPipelineShaderStageCreateInfo& stage) {
+  if (stage.module != VK_NULL_HANDLE) return state.ray_bindings.Module(stage.module);
+  for (auto* s = static_cast<const VkBaseInStructure*>(stage.pNext); s; s = s->pNext) {
+    if (s->sType == VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO) {
+      const auto* code = reinterpret_cast<const VkShaderModuleCreateInfo*>(s);
+      return ScanShaderStructureUse(code->pCode, code->codeSize / sizeof(uint32_t));
+    }
+  }
+  return std::nullopt;
+}
+
+void MergeStage(const DeviceState& state, const VkPipelineShaderStageCreateInfo& stage, PipelineStructureUse& use) {
+  const std::optional<ShaderStructureUse> scanned = StageUse(state, stage);
+  if (scanned) {
+    use.use.Merge(*scanned);
+  } else {
+    use.partly_unknown = true;
+  }
+}
+
+void Keep(DeviceState& state, VkPipeline pipeline, PipelineStructureUse use, VkPipelineCreateFlags flags) {
+  if (pipeline == VK_NULL_HANDLE || !use.use.uses_structures()) return;
+  use.descriptor_buffers = (flags & VK_PIPELINE_CREATE_DESCRIPTOR_BUFFER_BIT_EXT) != 0;
+  state.ray_bindings.AddPipeline(pipeline, std::make_shared<const PipelineStructureUse>(std::move(use)));
+}
+
+// The recording of cb while traces are followed and some pipeline reads structures; null otherwise.
+std::shared_ptr<CommandBufferState> Following(DeviceState& state, VkCommandBuffer cb) {
+  if (!state.traces_tracked || !state.ray_bindings.any_pipeline()) return nullptr;
+  return state.command_buffers.Find(cb);
+}
+
+// The object creations and descriptor updates allocate; a failure leaves the object unfollowed (its traces are
+// then not judged: a set never written is skipped, a pipeline not kept is not followed), counted.
+template <typename F>
+void Guarded(const DeviceState& state, F&& write) {
+  try {
+    write();
+  } catch (const std::bad_alloc&) {
+    state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+}  // namespace
+
+void RecordCreateShaderModule(DeviceState& state, const VkShaderModuleCreateInfo& info, VkShaderModule module) {
+  if (!state.traces_tracked) return;
+  Guarded(state, [&] {
+    state.ray_bindings.AddModule(module, ScanShaderStructureUse(info.pCode, info.codeSize / sizeof(uint32_t)));
+  });
+}
+
+void RecordDestroyShaderModule(DeviceState& state, VkShaderModule module) {
+  if (state.traces_tracked && module != VK_NULL_HANDLE) state.ray_bindings.ForgetModule(module);
+}
+
+void RecordCreateComputePipelines(DeviceState& state, uint32_t count, const VkComputePipelineCreateInfo* infos,
+                                  const VkPipeline* pipelines) {
+  if (!state.traces_tracked || !infos || !pipelines) return;
+  Guarded(state, [&] {
+    for (uint32_t i = 0; i < count; ++i) {
+      PipelineStructureUse use;
+      MergeStage(state, infos[i].stage, use);
+      Keep(state, pipelines[i], std::move(use), infos[i].flags);
+    }
+  });
+}
+
+void RecordCreateRayTracingPipelines(DeviceState& state, uint32_t count, const VkRayTracingPipelineCreateInfoKHR* infos,
+                                     const VkPipeline* pipelines) {
+  if (!state.traces_tracked || !infos || !pipelines) return;
+  Guarded(state, [&] {
+    for (uint32_t i = 0; i < count; ++i) {
+      const VkRayTracingPipelineCreateInfoKHR& info = infos[i];
+      PipelineStructureUse use;
+      for (uint32_t s = 0; info.pStages && s < info.stageCount; ++s) MergeStage(state, info.pStages[s], use);
+      // Libraries are pipelines created through this layer: their uses were kept (none kept: they read none).
+      for (uint32_t l = 0; info.pLibraryInfo && info.pLibraryInfo->pLibraries && l < info.pLibraryInfo->libraryCount;
+           ++l) {
+        if (auto library = state.ray_bindings.Pipeline(info.pLibraryInfo->pLibraries[l])) {
+          use.use.Merge(library->use);
+          use.partly_unknown |= library->partly_unknown;
+        }
+      }
+      Keep(state, pipelines[i], std::move(use), info.flags);
+    }
+  });
+}
+
+void RecordDestroyPipeline(DeviceState& state, VkPipeline pipeline) {
+  if (state.traces_tracked && pipeline != VK_NULL_HANDLE) state.ray_bindings.ForgetPipeline(pipeline);
+}
+
+void RecordCreateDescriptorSetLayout(DeviceState& state, const VkDescriptorSetLayoutCreateInfo& info,
+                                     VkDescriptorSetLayout layout) {
+  if (state.traces_tracked) Guarded(state, [&] { state.ray_bindings.AddLayout(info, layout); });
+}
+
+void RecordDestroyDescriptorSetLayout(DeviceState& state, VkDescriptorSetLayout layout) {
+  if (state.traces_tracked && layout != VK_NULL_HANDLE) state.ray_bindings.ForgetLayout(layout);
+}
+
+void RecordCreateDescriptorUpdateTemplate(DeviceState& state, const VkDescriptorUpdateTemplateCreateInfo& info,
+                                          VkDescriptorUpdateTemplate update_template) {
+  if (state.traces_tracked) Guarded(state, [&] { state.ray_bindings.AddTemplate(info, update_template); });
+}
+
+void RecordDestroyDescriptorUpdateTemplate(DeviceState& state, VkDescriptorUpdateTemplate update_template) {
+  if (state.traces_tracked && update_template != VK_NULL_HANDLE) state.ray_bindings.ForgetTemplate(update_template);
+}
+
+void RecordAllocateDescriptorSets(DeviceState& state, const VkDescriptorSetAllocateInfo& info,
+                                  const VkDescriptorSet* sets) {
+  if (!state.traces_tracked || state.ray_bindings.idle()) return;
+  Guarded(state, [&] { state.ray_bindings.Allocate(info, sets); });
+}
+
+void RecordFreeDescriptorSets(DeviceState& state, uint32_t count, const VkDescriptorSet* sets) {
+  if (state.traces_tracked) state.ray_bindings.Free(count, sets);
+}
+
+void RecordResetDescriptorPool(DeviceState& state, VkDescriptorPool pool) {
+  if (state.traces_tracked) state.ray_bindings.ResetPool(pool);
+}
+
+void RecordUpdateDescriptorSets(DeviceState& state, uint32_t write_count, const VkWriteDescriptorSet* writes,
+                                uint32_t copy_count, const VkCopyDescriptorSet* copies) {
+  if (!state.traces_tracked || state.ray_bindings.idle()) return;
+  Guarded(state, [&] {
+    state.ray_bindings.Update(write_count, writes, copy_count, copies,
+                              [&](VkAccelerationStructureKHR as) { return SerialOf(state, as); });
+  });
+}
+
+void RecordUpdateDescriptorSetWithTemplate(DeviceState& state, VkDescriptorSet set,
+                                           VkDescriptorUpdateTemplate update_template, const void* data) {
+  if (!state.traces_tracked || state.ray_bindings.idle() || !data) return;
+  Guarded(state, [&] {
+    state.ray_bindings.UpdateWithTemplate(set, update_template, data,
+                                          [&](VkAccelerationStructureKHR as) { return SerialOf(state, as); });
+  });
+}
+
+void RecordBindPipelineForTraces(DeviceState& state, VkCommandBuffer cb, VkPipelineBindPoint bind_point,
+                                 VkPipeline pipeline) {
+  const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
+  if (point == BoundStructures::kPointCount) return;
+  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
+    recording->bound_structures.BindPipeline(point, state.ray_bindings.Pipeline(pipeline));
+  }
+}
+
+void RecordBindDescriptorSets(DeviceState& state, VkCommandBuffer cb, VkPipelineBindPoint bind_point,
+                              uint32_t first_set, uint32_t count, const VkDescriptorSet* sets) {
+  const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
+  if (point == BoundStructures::kPointCount) return;
+  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
+    Guarded(state, [&] { recording->bound_structures.BindSets(point, first_set, count, sets); });
+  }
+}
+
+void RecordPushDescriptorSet(DeviceState& state, VkCommandBuffer cb, VkPipelineBindPoint bind_point, uint32_t set,
+                             uint32_t write_count, const VkWriteDescriptorSet* writes) {
+  const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
+  if (point == BoundStructures::kPointCount) return;
+  std::shared_ptr<CommandBufferState> recording = Following(state, cb);
+  if (!recording) return;
+  BoundStructures& bound = recording->bound_structures;
+  Guarded(state, [&] {
+    bound.BeginPush(point, set);
+    for (uint32_t i = 0; writes && i < write_count; ++i) {
+      if (writes[i].descriptorType != VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) continue;
+      const std::optional<std::vector<DescribedStructure>> structures =
+          RayBindings::WrittenStructures(writes[i], [&](VkAccelerationStructureKHR as) { return SerialOf(state, as); });
+      if (!structures) return bound.PushUnknown(point, set);
+      for (std::size_t e = 0; e < structures->size(); ++e) {
+        bound.Push(point, set, writes[i].dstBinding, writes[i].dstArrayElement + static_cast<uint32_t>(e),
+                   (*structures)[e]);
+      }
+    }
+  });
+}
+
+void RecordPushDescriptorSetWithTemplate(DeviceState& state, VkCommandBuffer cb, uint32_t set) {
+  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
+    Guarded(state, [&] {
+      recording->bound_structures.PushUnknown(BoundStructures::kCompute, set);
+      recording->bound_structures.PushUnknown(BoundStructures::kRayTracing, set);
+    });
+  }
+}
+
+void RecordExecuteForTraces(DeviceState& state, VkCommandBuffer primary) {
+  if (std::shared_ptr<CommandBufferState> recording = Following(state, primary)) {
+    recording->bound_structures.Forget();
+  }
+}
+
+void RecordTraceCommand(DeviceState& state, VkCommandBuffer cb, OpCommand command) {
+  std::shared_ptr<CommandBufferState> recording = Following(state, cb);
+  if (!recording) return;
+  const bool traces = command == OpCommand::kCmdTraceRays || command == OpCommand::kCmdTraceRaysIndirect ||
+                      command == OpCommand::kCmdTraceRaysIndirect2;
+  const BoundStructures::Point point = traces ? BoundStructures::kRayTracing : BoundStructures::kCompute;
+  if (!recording->bound_structures.pipeline(point)) return;
+  thread_local std::vector<TracedBinding> traced;
+  traced.clear();
+  try {
+    recording->bound_structures.MakeTraced(point, traces, traced);
+    OpOrigin origin;
+    origin.command = command;
+    origin.ordinal = recording->NextOrdinal(command);
+    origin.command_buffer = cb;
+    recording->recording.AppendTrace(origin, traced.data(), static_cast<uint32_t>(traced.size()));
+  } catch (const std::bad_alloc&) {
+    // The trace is not judged; the recording's history stays exact (a trace changes no structure).
+    state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+}  // namespace asval
