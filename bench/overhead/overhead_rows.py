@@ -40,6 +40,8 @@ ROWS: List[Row] = [
     _build(16, 256, 10, 3),
     Row("submit 1000 build+update", "submit", "bench/overhead/submit_history", ["build-update", "1000", "{n}"], 20, 3),
     Row("submit 1000 updates", "submit", "bench/overhead/submit_history", ["update", "1000", "{n}"], 20, 3),
+    # 100 ray-query dispatches over a TLAS of 10,000 instances (issue 29: judged per dispatch, not per instance).
+    Row("submit 100 ray queries", "submit", "bench/overhead/submit_traces", ["{n}", "100", "10000"], 20, 3),
     Row("buffer cycle", "buffer", "bench/overhead/buffer_cycle", ["{n}"], 5000, 500),
     # The sample scene at 128x128 (a lavapipe frame is ~14 ms); frame 0 (the builds) is not counted.
     Row("frame dynamic", "frame", "examples/scene/asval_scene", ["--frames", "{n}", "--size", "128x128"], 31, 6,

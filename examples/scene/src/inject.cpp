@@ -106,6 +106,7 @@ class Injector {
   void DestroyedInstance();
   void QueryWithoutCompaction();
   void ScratchDestroyedPending();
+  void TracedUnbuilt();
 
   Scene& s_;
   Gpu& gpu_;
@@ -132,6 +133,7 @@ void Injector::Run() {
     case FaultId::kDestroyedInstance: return DestroyedInstance();
     case FaultId::kQueryWithoutCompaction: return QueryWithoutCompaction();
     case FaultId::kScratchDestroyedPending: return ScratchDestroyedPending();
+    case FaultId::kTracedUnbuilt: return TracedUnbuilt();
   }
 }
 
@@ -365,6 +367,24 @@ void InjectFault(Scene& scene, const FaultInfo& fault) {
   std::fflush(stdout);
   Injector(scene, fault).Run();
   std::fflush(stdout);
+}
+
+void Injector::TracedUnbuilt() {
+  // A second handle over the bytes of the scene's top level, never built itself: the rule is about the structure
+  // the descriptor names (no build executed on it), while the device reads a valid top level either way.
+  const AccelerationStructure& top = s_.top.structure();
+  VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+  info.buffer = top.storage.buffer;
+  info.size = top.size;
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  VkAccelerationStructureKHR unbuilt = VK_NULL_HANDLE;
+  Check(gpu_.vk().CreateAccelerationStructureKHR(gpu_.device(), &info, nullptr, &unbuilt),
+        "vkCreateAccelerationStructureKHR");
+  s_.tracer.SetScene(unbuilt);
+  std::printf("fault: tracing through a top-level structure no build executed on\n");
+  RecordAndSubmit([&](VkCommandBuffer cb) { s_.tracer.RecordTrace(cb); });
+  s_.tracer.SetScene(top.handle);
+  gpu_.vk().DestroyAccelerationStructureKHR(gpu_.device(), unbuilt, nullptr);
 }
 
 }  // namespace scene

@@ -1,0 +1,77 @@
+#pragma once
+// Trace and ray-query work for the family traces (issue 29): a pipeline that reads a top-level structure through a
+// descriptor (set 0, binding 0) and writes whether its one ray hit into a storage buffer (binding 1), and a scene of
+// one triangle under that ray. Shared by tests/integration/traces_test.cpp and the corpus (tests/corpus).
+#include <vulkan/vulkan.h>
+
+#include "history_helpers.h"
+
+namespace asval_test {
+
+// A device with ray-tracing pipelines and push descriptors besides what every test device has (ray queries on
+// lavapipe).
+vkkit::DeviceOptions RayDevice();
+
+// A compute pipeline with a ray query (ray_query.comp) or a ray-tracing pipeline (trace_ray.rgen and
+// trace_miss.rmiss, with its shader binding table). `push`: the set layout is for push descriptors (no set).
+class RayProgram {
+ public:
+  enum class Kind { kRayQuery, kTraceRays };
+  RayProgram(vkkit::Device& device, Kind kind, bool push = false);
+  ~RayProgram();
+  RayProgram(const RayProgram&) = delete;
+  RayProgram& operator=(const RayProgram&) = delete;
+
+  VkDescriptorSet set() const { return set_; }
+  // Writes `structure` into the set's binding 0 (and the output buffer into binding 1).
+  void Write(VkAccelerationStructureKHR structure);
+  // Binds the pipeline and the set (or pushes `pushed`), and traces or dispatches one ray.
+  void Record(VkCommandBuffer cb, VkAccelerationStructureKHR pushed = VK_NULL_HANDLE);
+  // Build writes made visible to the ray's reads.
+  void BarrierAfterBuild(VkCommandBuffer cb) const;
+  // What the last ray wrote (1: it hit); Clear() writes 7.
+  uint32_t hit() const { return *static_cast<const uint32_t*>(output_.mapped); }
+  void Clear() { *static_cast<uint32_t*>(output_.mapped) = 7; }
+
+ private:
+  struct Writes;
+  VkPipelineBindPoint bind_point() const {
+    return kind_ == Kind::kRayQuery ? VK_PIPELINE_BIND_POINT_COMPUTE : VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR;
+  }
+  void MakeComputePipeline();
+  void MakeRayTracingPipeline();
+
+  vkkit::Device& device_;
+  Kind kind_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  vkkit::Buffer output_;
+  vkkit::Buffer sbt_;
+  VkStridedDeviceAddressRegionKHR raygen_{}, miss_{};
+};
+
+// A bottom-level structure of one triangle under the ray and a top-level structure with one instance of it.
+struct RayScene {
+  explicit RayScene(vkkit::Device& d)
+      : device(d), inputs(d), blas(d, inputs), tlas(d), instances(tlas.MakeInstances({&blas})) {}
+  ~RayScene() { device.Destroy(instances); }
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+  // Both builds, with the barrier between them.
+  void Build(Commands& commands, VkCommandBuffer cb) {
+    blas.Build(cb, Shape{});
+    commands.Barrier(cb);
+    tlas.Record(cb, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  }
+
+  vkkit::Device& device;
+  Inputs inputs;
+  Blas blas;
+  Tlas tlas;
+  vkkit::Buffer instances;
+};
+
+}  // namespace asval_test
