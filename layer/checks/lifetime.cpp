@@ -52,6 +52,26 @@ std::string Describe(const InFlightBatch& batch, const AsOp& op) {
                      batch.submit_index);
 }
 
+// The structures an operation names by handle, as f(structure, serial): its source and destination (serial 0: the
+// handle as created before the submission), and for a trace or dispatch (family traces) the structures its bound
+// descriptors name, with the serial each had when written (a set's binding is read now: one that a pending command
+// reads cannot be rewritten before it completes).
+template <typename F>
+void ForEachStructure(const CheckContext& ctx, const OpBatch& batch, const AsOp& op, F&& f) {
+  if (op.src) f(op.src, uint64_t{0});
+  if (op.dst) f(op.dst, uint64_t{0});
+  if (op.kind != OpKind::kTrace) return;
+  const TracedBinding* bindings = batch.traced().begin() + op.first_geometry;
+  for (uint32_t i = 0; i < op.geometry_count; ++i) {
+    const TracedBinding& b = bindings[i];
+    if (b.source == TracedSource::kPushed && b.pushed && b.pushed_serial) f(b.pushed, b.pushed_serial);
+    if (b.source != TracedSource::kSet) continue;
+    ctx.state.ray_bindings.ForEachIn(b.set, b.binding, [&](const DescribedStructure& d) {
+      if (d.as && d.serial) f(d.as, d.serial);
+    });
+  }
+}
+
 template <typename Uses>
 void ForEachOp(const InFlightBatch& batch, Uses&& uses) {
   for (const std::shared_ptr<const RecordedOps>& recorded : batch.recorded) {
@@ -75,20 +95,26 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
   if (!ctx.Enabled(kCheckLifetime) || in_flight.Empty()) return false;
   const std::shared_ptr<const AccelerationStructureState> record = StructureOf(ctx, structure, ~uint64_t{0});
   if (!record) return false;
-  const auto uses = [&](const AsOp& op) { return op.src == structure || op.dst == structure; };
+  const auto uses = [&](const RecordedOps& recorded, const AsOp& op) {
+    bool used = false;
+    ForEachStructure(ctx, recorded.batch, op, [&](VkAccelerationStructureKHR as, uint64_t serial) {
+      used |= as == structure && (serial == 0 || serial == record->serial);
+    });
+    return used;
+  };
   InFlightSkips skips;
   std::vector<std::string> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
       [&](const InFlightBatch& b) {
         if (b.serial < record->serial) return false;
         bool used = false;
-        ForEachOp(b, [&](const RecordedOps&, const AsOp& op) { used |= uses(op); });
+        ForEachOp(b, [&](const RecordedOps& recorded, const AsOp& op) { used = used || uses(recorded, op); });
         return used;
       },
       [&](const InFlightBatch& b) {
         const AsOp* first = nullptr;
-        ForEachOp(b, [&](const RecordedOps&, const AsOp& op) {
-          if (!first && uses(op)) first = &op;
+        ForEachOp(b, [&](const RecordedOps& recorded, const AsOp& op) {
+          if (!first && uses(recorded, op)) first = &op;
         });
         if (!first) return;
         findings.push_back(fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
@@ -166,16 +192,16 @@ FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, const Going& 
       }
     }
     for (const AsOp& op : ops) {
-      for (VkAccelerationStructureKHR as : {op.src, op.dst}) {
-        if (!going_away.Names(as)) continue;
+      ForEachStructure(ctx, recorded->batch, op, [&](VkAccelerationStructureKHR as, uint64_t serial) {
+        if (found.op || !going_away.Names(as)) return;
         const std::shared_ptr<const AccelerationStructureState> s = StructureOf(ctx, as, b.serial);
-        if (!s) continue;
+        if (!s || (serial != 0 && s->serial != serial)) return;
         const std::shared_ptr<const BufferState> buffer = BufferOfStructure(ctx.state, *s);
-        if (!buffer || !buffer->bound || buffer->bound_serial > b.serial || !goes(*buffer)) continue;
+        if (!buffer || !buffer->bound || buffer->bound_serial > b.serial || !goes(*buffer)) return;
         found.op = &op;
         found.how = fmt::format("the storage of VkAccelerationStructureKHR 0x{:x}", reinterpret_cast<uint64_t>(as));
-        return found;
-      }
+      });
+      if (found.op) return found;
     }
   }
   return found;

@@ -162,7 +162,9 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
   }
   data->state.history_tracked = instance->settings.TracksHistory();
   data->state.lifetime_tracked = data->state.history_tracked && (instance->settings.enabled_checks & kCheckLifetime);
-  data->state.traces_tracked = data->state.history_tracked && (instance->settings.enabled_checks & kCheckTraces);
+  // Traces are followed for family traces, and for lifetime (a structure a pending trace reads is in use).
+  data->state.traces_tracked =
+      data->state.history_tracked && (instance->settings.enabled_checks & (kCheckTraces | kCheckLifetime));
   const LayerSettings& settings = instance->settings;
   data->state.instance_activity_snapshots =
       settings.capture == kCaptureAll &&

@@ -64,8 +64,9 @@ class DeviceState {
   // Family lifetime is on: device builds keep the addresses they read and write (OpBatch::touches), which the
   // in-flight checks look up when an object is destroyed (layer/checks/lifetime.h).
   bool lifetime_tracked = true;
-  // Family traces is on: the structures that trace and ray-query work binds are followed (ray_bindings.h), and each
-  // trace or dispatch reading them is judged at submission (layer/checks/traced_structures.h).
+  // Family traces or lifetime is on: the structures that trace and ray-query work binds are followed (ray_bindings.h):
+  // traces judges each trace or dispatch reading them at submission (layer/checks/traced_structures.h), lifetime
+  // holds them in use while it is pending (layer/checks/lifetime.h).
   bool traces_tracked = true;
   // With capture = all, degenerate instances (the degenerate_instance capture warning, info severity) or instance
   // translations (the float_spacing capture warning) are judged: each captured top-level build keeps the activity

@@ -329,6 +329,11 @@ Tlas::~Tlas() {
   device_.Destroy(scratch_);
 }
 
+void Tlas::DestroyHandle() {
+  if (as_.handle) device_.DestroyAccelerationStructureKHR(device_.handle(), as_.handle, nullptr);
+  as_.handle = VK_NULL_HANDLE;
+}
+
 VkAccelerationStructureInstanceKHR InstanceRecord(VkDeviceAddress reference, uint32_t i) {
   VkAccelerationStructureInstanceKHR instance{};
   instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;

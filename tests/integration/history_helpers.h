@@ -196,6 +196,8 @@ class Tlas {
   // The info Record would record, for a call of several infos (RecordBuilds).
   BuildInfo Info(const vkkit::Buffer& instances, uint32_t count, VkBuildAccelerationStructureModeKHR mode) const;
   VkAccelerationStructureKHR handle() const { return as_.handle; }
+  // Destroys the structure, not its storage (lifetime tests).
+  void DestroyHandle();
 
  private:
   vkkit::Device& device_;

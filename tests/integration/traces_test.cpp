@@ -106,5 +106,54 @@ TEST_CASE("traces valid twin: the trace reads a structure built earlier in execu
   CHECK(f.monitor().Verify() == "");
 }
 
+// Family lifetime over traces: a structure a pending trace or dispatch reads through its descriptors is in use. The
+// dispatch is held pending by a timeline wait the host signals after the destroy.
+vkkit::DeviceOptions RayTimelineDevice() {
+  vkkit::DeviceOptions options = RayDevice();
+  options.timeline_semaphore = true;
+  return options;
+}
+
+TEST_CASE(
+    "lifetime: a top-level structure destroyed while a pending ray query reads it is reported "
+    "(accelerationStructure-02442)",
+    "[integration][lifetime][traces]") {
+  HistoryFixture f("lifetime", {}, RayTimelineDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Timeline gate(device);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
+  REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);  // runs once the host signals 1
+  f.monitor().Expect("VUID-vkDestroyAccelerationStructureKHR-accelerationStructure-02442");
+  scene.tlas.DestroyHandle();  // skipped by the monitor: the layer makes it once the dispatch completed
+  CHECK(f.monitor().Verify() == "");
+  CHECK(gate.HostSignal(1) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("lifetime valid twin: a top-level structure destroyed after the ray query reading it completed stays silent",
+          "[integration][lifetime][traces]") {
+  HistoryFixture f(nullptr, {}, RayTimelineDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Timeline gate(device);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
+  REQUIRE(SubmitOn(device.queue(), cb, gate, 0, 1) == VK_SUCCESS);
+  REQUIRE(gate.HostWait(1, 10ull * 1000 * 1000 * 1000) == VK_SUCCESS);  // completed, learned on the host
+  scene.tlas.DestroyHandle();
+  CHECK(program.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
 }  // namespace
 }  // namespace asval_test
