@@ -106,6 +106,46 @@ TEST_CASE("traces valid twin: the trace reads a structure built earlier in execu
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE("traces: a dispatch recorded in a secondary command buffer is judged where the primary executes it",
+          "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram built(device, RayProgram::Kind::kRayQuery);
+  built.Write(scene.tlas.handle());
+  Tlas never_built(device);
+  RayProgram unbuilt(device, RayProgram::Kind::kRayQuery);
+  unbuilt.Write(never_built.handle());
+  // The primary's own dispatch reads the built structure; the secondary's, after it, the one never built: the
+  // secondary's binding follows the primary's in the executed recording.
+  const VkCommandBuffer secondary = commands.BeginSecondary();
+  unbuilt.Record(secondary);
+  commands.End(secondary);
+  const VkCommandBuffer primary = Recorded(commands, [&](VkCommandBuffer c) {
+    built.Record(c);
+    vkCmdExecuteCommands(c, 1, &secondary);
+  });
+  f.monitor().Expect(kRayQueryBuilt);
+  commands.Submit(primary);
+  CHECK(f.monitor().Verify() == "");
+  // Valid twin: a secondary recorded over the descriptor rewritten with the built structure (rewriting it
+  // invalidated the recordings above, which are not submitted again).
+  unbuilt.Write(scene.tlas.handle());
+  const VkCommandBuffer secondary_twin = commands.BeginSecondary();
+  unbuilt.Record(secondary_twin);
+  commands.End(secondary_twin);
+  const VkCommandBuffer twin = Recorded(commands, [&](VkCommandBuffer c) {
+    built.Record(c);
+    vkCmdExecuteCommands(c, 1, &secondary_twin);
+  });
+  unbuilt.Clear();
+  REQUIRE(commands.Submit(twin) == VK_SUCCESS);
+  CHECK(unbuilt.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
 // Family lifetime over traces: a structure a pending trace or dispatch reads through its descriptors is in use. The
 // dispatch is held pending by a timeline wait the host signals after the destroy.
 vkkit::DeviceOptions RayTimelineDevice() {
