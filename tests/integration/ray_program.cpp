@@ -1,5 +1,6 @@
 #include "ray_program.h"
 
+#include <cstddef>
 #include <cstring>
 #include <vector>
 
@@ -106,6 +107,27 @@ RayProgram::~RayProgram() {
 void RayProgram::Write(VkAccelerationStructureKHR structure) {
   const Writes w(*this, structure);
   vkUpdateDescriptorSets(device_.handle(), 2, w.writes, 0, nullptr);
+}
+
+void RayProgram::WriteWithTemplate(VkAccelerationStructureKHR structure) {
+  // The template's data: the structure's handle, then the output buffer's descriptor.
+  struct Data {
+    VkAccelerationStructureKHR structure;
+    VkDescriptorBufferInfo output;
+  } data{structure, {output_.buffer, 0, VK_WHOLE_SIZE}};
+  const VkDescriptorUpdateTemplateEntry entries[2] = {
+      {0, 0, 1, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, offsetof(Data, structure), sizeof(Data)},
+      {1, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, offsetof(Data, output), sizeof(Data)}};
+  VkDescriptorUpdateTemplateCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_UPDATE_TEMPLATE_CREATE_INFO};
+  info.descriptorUpdateEntryCount = 2;
+  info.pDescriptorUpdateEntries = entries;
+  info.templateType = VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET;
+  info.descriptorSetLayout = set_layout_;
+  VkDescriptorUpdateTemplate update_template = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateDescriptorUpdateTemplate(device_.handle(), &info, nullptr, &update_template),
+               "vkCreateDescriptorUpdateTemplate");
+  vkUpdateDescriptorSetWithTemplate(device_.handle(), set_, update_template, &data);
+  vkDestroyDescriptorUpdateTemplate(device_.handle(), update_template, nullptr);
 }
 
 void RayProgram::Record(VkCommandBuffer cb, VkAccelerationStructureKHR pushed) {

@@ -25,6 +25,8 @@ class RayProgram {
   VkDescriptorSet set() const { return set_; }
   // Writes `structure` into the set's binding 0 (and the output buffer into binding 1).
   void Write(VkAccelerationStructureKHR structure);
+  // The same through a descriptor update template (vkUpdateDescriptorSetWithTemplate).
+  void WriteWithTemplate(VkAccelerationStructureKHR structure);
   // Binds the pipeline and the set (or pushes `pushed`), and traces or dispatches one ray.
   void Record(VkCommandBuffer cb, VkAccelerationStructureKHR pushed = VK_NULL_HANDLE);
   // Build writes made visible to the ray's reads.

@@ -146,6 +146,26 @@ TEST_CASE("traces: a dispatch recorded in a secondary command buffer is judged w
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE("traces: descriptors written through an update template are followed", "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  Tlas never_built(device);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.WriteWithTemplate(never_built.handle());
+  f.monitor().Expect(kRayQueryBuilt);
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));
+  CHECK(f.monitor().Verify() == "");
+  // Valid twin: the template rewrites the descriptor with a built structure before the recording.
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  program.WriteWithTemplate(scene.tlas.handle());
+  program.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); })) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
 // Family lifetime over traces: a structure a pending trace or dispatch reads through its descriptors is in use. The
 // dispatch is held pending by a timeline wait the host signals after the destroy.
 vkkit::DeviceOptions RayTimelineDevice() {
