@@ -1,17 +1,19 @@
 #include "bench_device.h"
 
+#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
 #include <vector>
 
+#include "instrument.h"
+
 namespace overhead {
 
 namespace {
 
-VKAPI_ATTR VkBool32 VKAPI_CALL Count(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                     VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                     void* user) {
+VKAPI_ATTR VkBool32 VKAPI_CALL Count(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   BenchDevice& bench = *static_cast<BenchDevice*>(user);
   const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   error ? ++bench.errors : ++bench.warnings;
@@ -81,6 +83,58 @@ int BenchDevice::Finish(long calls, double seconds) {
   std::printf("ns_per_call: %.1f calls: %ld\n", seconds * 1e9 / static_cast<double>(calls), calls);
   std::printf("validation messages: %u error(s), %u warning(s)\n", errors, warnings);
   return errors + warnings ? 3 : 0;
+}
+
+VkCommandPool CreatePool(VkPhysicalDevice gpu, VkDevice device) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
+  uint32_t family = 0;
+  while (family < count && !(families[family].queueFlags & VK_QUEUE_COMPUTE_BIT)) ++family;
+  VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  info.queueFamilyIndex = family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  vkkit::Check(vkCreateCommandPool(device, &info, nullptr, &pool), "vkCreateCommandPool");
+  return pool;
+}
+
+VkCommandBuffer BeginReusable(VkDevice device, VkCommandPool pool) {
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  vkkit::Check(vkAllocateCommandBuffers(device, &alloc, &cb), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};  // no ONE_TIME_SUBMIT
+  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
+  return cb;
+}
+
+namespace {
+
+void Submit(VkQueue queue, VkCommandBuffer cb) {
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  vkkit::Check(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
+}
+
+}  // namespace
+
+double TimeSubmissions(VkQueue queue, VkCommandBuffer cb, int submissions) {
+  Submit(queue, cb);
+  vkkit::Check(vkQueueWaitIdle(queue), "vkQueueWaitIdle");
+  double seconds = 0;
+  for (int s = 0; s < submissions; ++s) {
+    const auto start = std::chrono::steady_clock::now();
+    OVERHEAD_START_INSTRUMENTATION;
+    Submit(queue, cb);
+    OVERHEAD_STOP_INSTRUMENTATION;
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    vkkit::Check(vkQueueWaitIdle(queue), "vkQueueWaitIdle");
+  }
+  return seconds;
 }
 
 int Main(const char* program, int (*body)(int argc, char** argv), int argc, char** argv) {

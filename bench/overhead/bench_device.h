@@ -39,6 +39,15 @@ class BenchDevice {
   std::unique_ptr<vkkit::Device> device_;
 };
 
+// A pool on the queue family vkkit::Device takes its queue from (the first with compute), and a primary command
+// buffer from it, begun for reuse (submitted many times).
+VkCommandPool CreatePool(VkPhysicalDevice gpu, VkDevice device);
+VkCommandBuffer BeginReusable(VkDevice device, VkCommandPool pool);
+// Submits cb once, not measured (the driver compiles its pipelines at their first use), then `submissions` times,
+// timing vkQueueSubmit alone (between the callgrind client requests: instrument.h) and waiting for the queue after
+// each. Returns the seconds the measured submissions took.
+double TimeSubmissions(VkQueue queue, VkCommandBuffer cb, int submissions);
+
 // Runs body() and turns an exception into a message and exit status 1.
 int Main(const char* program, int (*body)(int argc, char** argv), int argc, char** argv);
 

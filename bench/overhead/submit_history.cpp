@@ -9,44 +9,15 @@
 // The command buffer is recorded once and submitted SUBMISSIONS times, after one submission that is not
 // measured. Only vkQueueSubmit is timed and between the callgrind client requests; the wait for the queue (where
 // the driver builds, and where asval judges what it captured) is outside.
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
 
 #include "bench_device.h"
-#include "instrument.h"
 #include "vkkit.h"
 
 namespace {
-
-// A pool on the queue family vkkit::Device takes its queue from (the first with compute).
-VkCommandPool CreatePool(VkPhysicalDevice gpu, VkDevice device) {
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(gpu, &count, families.data());
-  uint32_t family = 0;
-  while (family < count && !(families[family].queueFlags & VK_QUEUE_COMPUTE_BIT)) ++family;
-  VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  info.queueFamilyIndex = family;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateCommandPool(device, &info, nullptr, &pool), "vkCreateCommandPool");
-  return pool;
-}
-
-VkCommandBuffer Begin(VkDevice device, VkCommandPool pool) {
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  VkCommandBuffer cb = VK_NULL_HANDLE;
-  vkkit::Check(vkAllocateCommandBuffers(device, &alloc, &cb), "vkAllocateCommandBuffers");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};  // reusable: submitted many times
-  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
-  return cb;
-}
 
 // Builds written before the next builds read or write.
 void BuildBarrier(VkCommandBuffer cb) {
@@ -56,13 +27,6 @@ void BuildBarrier(VkCommandBuffer cb) {
       VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
   const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR;
   vkCmdPipelineBarrier(cb, stage, stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
-}
-
-void Submit(VkQueue queue, VkCommandBuffer cb) {
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  vkkit::Check(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
 }
 
 int Run(int argc, char** argv) {
@@ -111,15 +75,14 @@ int Run(int argc, char** argv) {
     }
   };
 
-  const VkCommandPool pool = CreatePool(bench.gpu(), handle);
+  const VkCommandPool pool = overhead::CreatePool(bench.gpu(), handle);
   if (update_only) {  // the builds the updates start from, executed before anything is measured
-    VkCommandBuffer first = Begin(handle, pool);
+    VkCommandBuffer first = overhead::BeginReusable(handle, pool);
     record(first, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
     vkkit::Check(vkEndCommandBuffer(first), "vkEndCommandBuffer");
-    Submit(device.queue(), first);
-    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+    overhead::TimeSubmissions(device.queue(), first, 0);  // submitted once, not measured
   }
-  VkCommandBuffer cb = Begin(handle, pool);
+  VkCommandBuffer cb = overhead::BeginReusable(handle, pool);
   if (build_update) {
     record(cb, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
     BuildBarrier(cb);
@@ -128,18 +91,7 @@ int Run(int argc, char** argv) {
   BuildBarrier(cb);  // the next submission's operations come after this one's
   vkkit::Check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
 
-  // Once before measuring: the driver compiles its build and update pipelines at their first use.
-  Submit(device.queue(), cb);
-  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
-  double seconds = 0;
-  for (int s = 0; s < submissions; ++s) {
-    const auto start = std::chrono::steady_clock::now();
-    OVERHEAD_START_INSTRUMENTATION;
-    Submit(device.queue(), cb);
-    OVERHEAD_STOP_INSTRUMENTATION;
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
-  }
+  const double seconds = overhead::TimeSubmissions(device.queue(), cb, submissions);
   std::printf("%d submissions of %d operations (%s)\n", submissions, build_update ? 2 * structures : structures,
               build_update ? "builds, then updates" : "updates");
   vkDestroyCommandPool(handle, pool, nullptr);

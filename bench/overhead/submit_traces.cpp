@@ -6,25 +6,16 @@
 //   triangle, built once (not measured); a command buffer of DISPATCHES (100) times bind pipeline, bind set and
 //   vkCmdDispatch(1, 1, 1), recorded once and submitted SUBMISSIONS times after one submission that is not measured.
 // Only vkQueueSubmit is timed and between the callgrind client requests.
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
 
 #include "bench_device.h"
-#include "instrument.h"
 #include "ray_query.comp.h"
 #include "vkkit.h"
 
 namespace {
-
-void Submit(VkQueue queue, VkCommandBuffer cb) {
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  vkkit::Check(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
-}
 
 // The top-level structure over `count` instances of `blas`, built and waited for.
 vkkit::AccelerationStructure BuildTopLevel(vkkit::Device& device, const vkkit::AccelerationStructure& blas,
@@ -142,25 +133,8 @@ int Run(int argc, char** argv) {
                                            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, nullptr, &buffer_info, nullptr}};
   vkUpdateDescriptorSets(d, 2, writes, 0, nullptr);
 
-  // A reusable command buffer (submitted many times), on the queue's family (the first with compute).
-  uint32_t family_count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(bench.gpu(), &family_count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(family_count);
-  vkGetPhysicalDeviceQueueFamilyProperties(bench.gpu(), &family_count, families.data());
-  uint32_t family = 0;
-  while (family < family_count && !(families[family].queueFlags & VK_QUEUE_COMPUTE_BIT)) ++family;
-  VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  command_pool_info.queueFamilyIndex = family;
-  VkCommandPool command_pool = VK_NULL_HANDLE;
-  vkkit::Check(vkCreateCommandPool(d, &command_pool_info, nullptr, &command_pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo cb_alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cb_alloc.commandPool = command_pool;
-  cb_alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cb_alloc.commandBufferCount = 1;
-  VkCommandBuffer cb = VK_NULL_HANDLE;
-  vkkit::Check(vkAllocateCommandBuffers(d, &cb_alloc, &cb), "vkAllocateCommandBuffers");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  vkkit::Check(vkBeginCommandBuffer(cb, &begin), "vkBeginCommandBuffer");
+  const VkCommandPool command_pool = overhead::CreatePool(bench.gpu(), d);
+  const VkCommandBuffer cb = overhead::BeginReusable(d, command_pool);
   for (int i = 0; i < dispatches; ++i) {
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
@@ -168,18 +142,7 @@ int Run(int argc, char** argv) {
   }
   vkkit::Check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
 
-  // Once before measuring: the driver compiles the pipeline at its first use.
-  Submit(device.queue(), cb);
-  vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
-  double seconds = 0;
-  for (int s = 0; s < submissions; ++s) {
-    const auto start = std::chrono::steady_clock::now();
-    OVERHEAD_START_INSTRUMENTATION;
-    Submit(device.queue(), cb);
-    OVERHEAD_STOP_INSTRUMENTATION;
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
-  }
+  const double seconds = overhead::TimeSubmissions(device.queue(), cb, submissions);
   std::printf("%d submissions of %d ray-query dispatches over %u instances\n", submissions, dispatches, instances);
   vkDestroyCommandPool(d, command_pool, nullptr);
   vkDestroyDescriptorPool(d, descriptor_pool, nullptr);
