@@ -15,7 +15,7 @@ namespace asval {
 
 namespace {
 
-constexpr std::size_t kNamed = 4;          // references named in a message; the rest are counted
+constexpr std::size_t kNamed = 4;               // references named in a message; the rest are counted
 constexpr uint32_t kMaxStructureFindings = 16;  // per build and rule: enough to show the pattern
 constexpr VkDeviceSize kInstanceBytes = sizeof(VkAccelerationStructureInstanceKHR);
 constexpr std::size_t kReferenceOffset = offsetof(VkAccelerationStructureInstanceKHR, accelerationStructureReference);
@@ -28,7 +28,7 @@ struct Referenced {
 };
 
 [[gnu::cold]] void Report(const CheckContext& ctx, const InstanceReferenceCheck& c, const char* rule,
-            VkAccelerationStructureKHR referenced, const std::string& message) {
+                          VkAccelerationStructureKHR referenced, const std::string& message) {
   const char* command = OpCommandName(c.build.command);
   const std::string vuid = fmt::format("VUID-{}-{}", command, rule);
   if (referenced == VK_NULL_HANDLE) {
@@ -61,7 +61,7 @@ const char* ReferenceRule(const InstanceReferenceCheck& c) {
 }
 
 [[gnu::cold]] void ReportTopLevel(const CheckContext& ctx, const InstanceReferenceCheck& c, uint32_t geometry,
-                                   uint64_t count, const std::string& named) {
+                                  uint64_t count, const std::string& named) {
   Report(ctx, c, ReferenceRule(c), VK_NULL_HANDLE,
          fmt::format("{}: builds top-level {}; on execution, geometry {}: {} instance(s) reference a top-level "
                      "acceleration structure, but an instance must reference a bottom-level one (the top level takes "
@@ -190,7 +190,9 @@ void CheckInstancePointers(const CheckContext& ctx, const InstanceReferenceCheck
                      DescribeOrigin(c.build), Hex(c.dst), geometry, misaligned, named));
 }
 
-bool BottomLevel(const AccelerationStructureState& s) { return s.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR; }
+bool BottomLevel(const AccelerationStructureState& s) {
+  return s.type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+}
 
 // A reduced geometry's references judged by their summaries (ReducedGeometry::Distinct): true when each names a
 // live structure, `first` (when asked) then holding, per structure, the first instance referencing it (the first
@@ -216,13 +218,15 @@ bool JudgeDistinctReferences(const ReducedGeometry& reduced, const LiveStructure
 
 }  // namespace
 
-void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& c) {
+bool CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& c,
+                             ReferencedStructures* referenced) {
   const CaptureLog* log = c.log.get();
   const CapturedInfo* readable = log ? log->Readable(c.info) : nullptr;
   if (!readable || !c.live) {
     CountUnknownState(ctx);
-    return;
+    return false;
   }
+  bool complete = true;  // every reference named a known structure (what `referenced` needs)
   const CapturedInfo& info = *readable;
   const LiveStructureAddresses& live = *c.live;
   // The rules about each referenced structure (03709, the same command's destinations, degenerate instances) run
@@ -231,11 +235,13 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   const bool per_structure = !live.all_bound || info.destination_count != 0 || !c.activities.empty();
   // Per live structure: the first instance that references it (structure -1: none).
   std::vector<Referenced> first;
-  if (per_structure) first.assign(live.structures.size(), Referenced{-1, 0, 0});
+  if (per_structure || referenced) first.assign(live.structures.size(), Referenced{-1, 0, 0});
+  const bool collect = per_structure || referenced;
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
     CapturedGeometry g;  // an indirect info's with its range as the device read it
     if (!ExecutedGeometry(*log, info, j, &g)) {
       CountUnknownState(ctx);
+      complete = false;
       continue;
     }
     if (g.type != VK_GEOMETRY_TYPE_INSTANCES_KHR || g.range.primitiveCount == 0) continue;
@@ -246,11 +252,14 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       // is zeros: inactive here, counted above); not gathered (capture.md says where): unknown.
       if (!g.data.present) CountUnknownState(ctx);
     }
-    if (!g.data.present) continue;
+    if (!g.data.present) {
+      complete = false;
+      continue;
+    }
     // Reduced on the device: each 64 records' distinct references, with the first record of each, are judged
     // instead of every record; only when one names no live structure are the records walked below (for the count
     // and the instances the message names).
-    if (g.reduced && JudgeDistinctReferences(log->Reduced(g), live, j, per_structure ? &first : nullptr)) continue;
+    if (g.reduced && JudgeDistinctReferences(log->Reduced(g), live, j, collect ? &first : nullptr)) continue;
     // The records as copied, or the references alone as the layer's dispatch wrote them (CapturedGeometry::reduced).
     const uint8_t* references = log->Bytes(g.data) + (g.reduced ? 0 : kReferenceOffset);
     const VkDeviceSize stride = g.reduced ? sizeof(uint64_t) : kInstanceBytes;
@@ -281,7 +290,7 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       }
       if (structure >= 0) {
         const AccelerationStructureState& s = *live.structures[static_cast<std::size_t>(structure)];
-        if (per_structure && first[static_cast<std::size_t>(structure)].structure < 0) {
+        if (collect && first[static_cast<std::size_t>(structure)].structure < 0) {
           first[static_cast<std::size_t>(structure)] = Referenced{structure, j, k};
         }
         if (BottomLevel(s)) continue;
@@ -303,11 +312,20 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
       if (bad++ < kNamed) named += fmt::format("{}instance {} references 0x{:x}", bad > 1 ? ", " : "", k, reference);
     }
     if (unknown) CountUnknownState(ctx);
+    if (unknown || bad != 0 || top_level != 0) complete = false;
     if (bad > kNamed) named += fmt::format(" (and {} more)", bad - kNamed);
     if (bad != 0) ReportStale(ctx, c, j, bad, named);
     if (top_level > kNamed) named_top_level += fmt::format(" (and {} more)", top_level - kNamed);
     if (top_level != 0) ReportTopLevel(ctx, c, j, top_level, named_top_level);
   }
+  if (referenced && complete) {
+    for (const Referenced& r : first) {
+      if (r.structure < 0) continue;
+      const AccelerationStructureState& s = *live.structures[static_cast<std::size_t>(r.structure)];
+      referenced->structures.push_back(ReferencedStructures::Referenced{s.handle, s.serial});
+    }
+  }
+  if (!per_structure) return complete;
   // Each referenced structure once, named by the first instance that references it.
   uint32_t findings = 0;
   for (const Referenced& r : first) {
@@ -323,6 +341,7 @@ void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
     if (findings >= kMaxStructureFindings) continue;
     findings += CheckReferenced(ctx, c, *log, info, r, k);
   }
+  return complete;
 }
 
 }  // namespace asval

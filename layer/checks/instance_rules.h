@@ -16,6 +16,9 @@
 
 namespace asval {
 
-void CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& build);
+// Returns whether every instance's reference could be judged and named a live bottom-level structure (or was 0);
+// then `referenced` (may be null) holds each distinct structure referenced, with its serial (family traces).
+bool CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceCheck& build,
+                             ReferencedStructures* referenced = nullptr);
 
 }  // namespace asval

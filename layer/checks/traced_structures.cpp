@@ -45,8 +45,37 @@ struct TracedJudge {
     }
     state.trace_counters.judged.fetch_add(1, std::memory_order_relaxed);
     const bool built = h && h->kind == HistoryKind::kBuilt && h->build;
-    if (built && h->build->type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return;
+    if (built && h->build->type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) return JudgeReferenced(b, d.as, *h);
     Report(b, d.as, built ? h : nullptr);
+  }
+
+  // The bottom-level structures the top level's last build referenced are still alive (the same structures: serials).
+  void JudgeReferenced(const TracedBinding& b, VkAccelerationStructureKHR top, const AsHistory& h) const {
+    const std::shared_ptr<const ReferencedStructures> refs = h.activity ? h.activity->references() : nullptr;
+    if (!refs) return Skip(TracedSkip::kReferencesUnknown);
+    // No structure created or destroyed since the last walk found them all alive: they still are.
+    const uint64_t structures_now = state.acceleration_structures.stamp().count + 1;
+    if (refs->verified_structures.load(std::memory_order_relaxed) == structures_now) return;
+    for (const ReferencedStructures::Referenced& r : refs->structures) {
+      const std::optional<std::shared_ptr<const AccelerationStructureState>> now =
+          state.acceleration_structures.find(r.as);
+      if (!now || !*now || (*now)->serial != r.serial) return ReportReferenced(b, top, h, r.as, "was destroyed");
+    }
+    refs->verified_structures.store(structures_now, std::memory_order_relaxed);
+  }
+
+  [[gnu::cold, gnu::noinline]] void ReportReferenced(const TracedBinding& b, VkAccelerationStructureKHR top,
+                                                     const AsHistory& h, VkAccelerationStructureKHR bottom,
+                                                     const char* what) const {
+    out.Add(Severity::kError, kBottomLevelInvalidId, site.loc,
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, top),
+             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, bottom)},
+            fmt::format("{}: the bound pipeline's shaders read the top-level VkAccelerationStructureKHR {} ({}), whose "
+                        "last build ({}) referenced the bottom-level VkAccelerationStructureKHR {}, which {} since. "
+                        "Bottom-level structures must be valid when the top level is accessed: rebuild the top level "
+                        "without it first.",
+                        DescribeOrigin(op.origin), Hex(top), Through(b), DescribeOrigin(h.build->origin), Hex(bottom),
+                        what));
   }
 
   // built_bottom: the history of a structure whose last build made a bottom-level one; null: never built.
@@ -84,6 +113,8 @@ const char* TracedSkipName(TracedSkip skip) {
       return "destroyed";
     case TracedSkip::kUnknownHistory:
       return "unknown_history";
+    case TracedSkip::kReferencesUnknown:
+      return "references_unknown";
     case TracedSkip::kCount:
       break;
   }

@@ -19,15 +19,21 @@
 namespace asval {
 
 enum class TracedSkip : uint8_t {
-  kNotBound,          // no set bound (or pushed) at that set number
-  kNotWritten,        // the set's binding holds no structure the layer saw written
-  kUnreadable,        // descriptors the layer does not read (templates pushed, descriptor buffers, ...)
-  kUnknownStructure,  // a structure the layer did not know when it was written
-  kDestroyed,         // destroyed since it was written (its descriptor is stale)
-  kUnknownHistory,    // the structure's history is unknown
+  kNotBound,           // no set bound (or pushed) at that set number
+  kNotWritten,         // the set's binding holds no structure the layer saw written
+  kUnreadable,         // descriptors the layer does not read (templates pushed, descriptor buffers, ...)
+  kUnknownStructure,   // a structure the layer did not know when it was written
+  kDestroyed,          // destroyed since it was written (its descriptor is stale)
+  kUnknownHistory,     // the structure's history is unknown
+  kReferencesUnknown,  // what its last build's instances referenced is not known (not captured, or not completed yet)
   kCount
 };
 const char* TracedSkipName(TracedSkip skip);
+
+// Layer-specific (the chapter's "Those bottom level acceleration structure objects must be valid when the top level
+// acceleration structure is accessed" has no VUID): a traced top level's last build referenced a bottom-level
+// structure that was destroyed since.
+inline constexpr const char kBottomLevelInvalidId[] = "ASVAL-Traces-BottomLevelInvalid";
 
 // Judges one kTrace operation against the histories before it. Call with the store's lock held.
 void CheckTracedStructures(const DeviceState& state, const HistoryStore& store, const OpBatch& batch, const AsOp& op,

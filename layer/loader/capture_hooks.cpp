@@ -32,7 +32,13 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
     }
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
     for (const InstanceReferenceCheck& build : done.instance_checks) {
-      CheckInstanceReferences(ctx, build);
+      // Family traces: what the top level references, for the traces that read it later (traced_structures.h).
+      const bool keep =
+          data.state.traces_tracked && build.activity && build.activity->status() != BuildActivity::Status::kUnknown;
+      auto referenced = keep ? std::make_shared<ReferencedStructures>() : nullptr;
+      if (CheckInstanceReferences(ctx, build, referenced.get()) && referenced) {
+        build.activity->SetReferences(std::move(referenced));
+      }
       ReportInstanceTransforms(ctx, build, warnings, spacing_permille);
     }
     for (const IndirectRangeCheck& build : done.indirect_checks) CheckIndirectRanges(ctx, build);
@@ -123,8 +129,7 @@ VKAPI_ATTR VkResult VKAPI_CALL GetFenceStatus(VkDevice device, VkFence fence) {
 }
 
 // Semaphore waits say nothing the layer maps to its submissions: what completed by now is processed.
-VKAPI_ATTR VkResult VKAPI_CALL WaitSemaphores(VkDevice device, const VkSemaphoreWaitInfo* pWaitInfo,
-                                              uint64_t timeout) {
+VKAPI_ATTR VkResult VKAPI_CALL WaitSemaphores(VkDevice device, const VkSemaphoreWaitInfo* pWaitInfo, uint64_t timeout) {
   DeviceData* data = GetDeviceData(device);
   const VkResult result = data->dispatch.WaitSemaphores(device, pWaitInfo, timeout);
   if (result == VK_SUCCESS && data->in_flight) data->in_flight->Poll();

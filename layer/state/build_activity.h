@@ -40,6 +40,19 @@ float FloatSpacingAt(float x);
 // Whether float spacing at `magnitude` exceeds permille / 1000 of `size` (ASVAL-Capture-FloatSpacing).
 bool SpacingExceeds(float magnitude, float size, uint32_t permille);
 
+// The structures a top-level build's instances referenced (issue 29, family traces): each distinct one with its
+// serial (AccelerationStructureState::serial), as the capture found them when the build's submission completed.
+// A trace of the top level walks them to see that each is still alive; the structure map's change stamp (plus one)
+// at the last walk that found them all alive is kept, and while it reads the same no walk is needed (0: never).
+struct ReferencedStructures {
+  struct Referenced {
+    VkAccelerationStructureKHR as = VK_NULL_HANDLE;
+    uint64_t serial = 0;
+  };
+  std::vector<Referenced> structures;
+  mutable std::atomic<uint64_t> verified_structures{0};
+};
+
 class BuildActivity {
  public:
   enum class Status : uint8_t { kPending, kReady, kUnknown };
@@ -47,9 +60,9 @@ class BuildActivity {
   // Input the specification leaves undefined, found while classifying one geometry (a warning, not a rule).
   struct UndefinedInput {
     uint32_t geometry = 0;
-    uint32_t primitives = 0;       // triangles with a NaN Y or Z while X is not NaN (AABBs: NaN outside minX)
+    uint32_t primitives = 0;  // triangles with a NaN Y or Z while X is not NaN (AABBs: NaN outside minX)
     uint32_t first_primitive = 0;
-    int transform_element = -1;    // triangles: the first NaN or infinite element of the transform (row * 4 + col)
+    int transform_element = -1;  // triangles: the first NaN or infinite element of the transform (row * 4 + col)
   };
 
   // Primitives whose coordinates are so large that 32-bit floats there are spaced more than a fraction of the
@@ -76,6 +89,15 @@ class BuildActivity {
   // it does not decode, bytes not captured) leave the whole activity unknown. spacing_permille > 0 also scans the
   // triangles and AABBs for coarse float spacing (coarse_spacing()): a second pass, so only when asked.
   void Fill(uint32_t spacing_permille = 0);
+  // Top-level builds: what its instances referenced, set once when its submission completed (after the instance
+  // rules judged them); null before, or when not all references named known structures. Readable without the
+  // processing lock (release/acquire).
+  void SetReferences(std::shared_ptr<const ReferencedStructures> references) {
+    std::atomic_store_explicit(&references_, std::move(references), std::memory_order_release);
+  }
+  std::shared_ptr<const ReferencedStructures> references() const {
+    return std::atomic_load_explicit(&references_, std::memory_order_acquire);
+  }
   // The bytes cannot be trusted (the same capture written twice before it was read): unknown.
   void MarkUnknown() {
     status_.store(Status::kUnknown, std::memory_order_release);
@@ -106,6 +128,7 @@ class BuildActivity {
   float smallest_ = 0;
   OpOrigin origin_;
   VkAccelerationStructureKHR dst_ = VK_NULL_HANDLE;
+  std::shared_ptr<const ReferencedStructures> references_;
 };
 
 // An update to compare with the activity of its source's last executed build (pInfos-03663, 03664, 03768).
@@ -129,6 +152,8 @@ struct InstanceReferenceCheck {
   std::vector<std::shared_ptr<const BuildActivity>> activities;
   OpOrigin build;
   VkAccelerationStructureKHR dst = VK_NULL_HANDLE;
+  // The build's activity node (the history's record of it): gets the structures the instances referenced.
+  std::shared_ptr<BuildActivity> activity;
 };
 
 struct BuildSnapshot;  // history.h (which includes this file)

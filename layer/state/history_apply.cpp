@@ -203,6 +203,7 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
     }
     check.build = op.origin;
     check.dst = op.dst;
+    check.activity = node;
     captures.instance_checks.push_back(std::move(check));
   }
   if (op.is_update()) captures.comparisons.push_back(ComparisonWithSource(store, op, node));

@@ -166,6 +166,64 @@ TEST_CASE("traces: descriptors written through an update template are followed",
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE(
+    "traces: a traced top level whose last build referenced a bottom level destroyed since is reported "
+    "(ASVAL-Traces-BottomLevelInvalid)",
+    "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  // Built and waited for: the capture has read the top level's instances by the time the wait returned.
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  scene.blas.DestroyHandle();  // its storage stays: a driver that ran the query would still find its bytes
+  f.monitor().Expect("ASVAL-Traces-BottomLevelInvalid");
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("traces valid twin: a bottom level destroyed once the traced top level was rebuilt without it stays silent",
+          "[integration][traces]") {
+  HistoryFixture f(nullptr, {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  // Streaming out: a new bottom level takes the old one's place in the top level, rebuilt and waited for; then the
+  // old one is destroyed and the top level traced.
+  Blas replacement(device, scene.inputs);
+  vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+    replacement.Build(c, Shape{});
+    commands.Barrier(c);
+    scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  })) == VK_SUCCESS);
+  scene.blas.DestroyHandle();
+  program.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); })) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  // Rebuilt in the same command buffer as the query, after another bottom level went: what that build referenced is
+  // not known before it completes (its references were judged there: pInfos-06707), so nothing is said.
+  Blas third(device, scene.inputs);
+  vkkit::Buffer third_instances = scene.tlas.MakeInstances({&third});
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { third.Build(c, Shape{}); })) == VK_SUCCESS);
+  replacement.DestroyHandle();  // the top level still references it, until the rebuild below runs
+  program.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+    scene.tlas.Record(c, third_instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    program.BarrierAfterBuild(c);
+    program.Record(c);
+  })) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  device.Destroy(instances);
+  device.Destroy(third_instances);
+  CHECK(f.monitor().Verify() == "");
+}
+
 // Family lifetime over traces: a structure a pending trace or dispatch reads through its descriptors is in use. The
 // dispatch is held pending by a timeline wait the host signals after the destroy.
 vkkit::DeviceOptions RayTimelineDevice() {
