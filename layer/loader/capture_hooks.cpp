@@ -33,6 +33,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
     for (const ActivityComparison& update : done.comparisons) CheckUpdateActivity(ctx, update);
     for (const InstanceReferenceCheck& build : done.instance_checks) {
       // Family traces: what the top level references, for the traces that read it later (traced_structures.h).
+      // Kept whether or not a pipeline reads structures yet: apps build their scene before creating pipelines too.
       const bool keep =
           data.state.traces_tracked && build.activity && build.activity->status() != BuildActivity::Status::kUnknown;
       auto referenced = keep ? std::make_shared<ReferencedStructures>() : nullptr;
