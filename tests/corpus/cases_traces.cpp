@@ -76,4 +76,23 @@ CORPUS_CASE(TracesNeverBuilt, "traces-ray-query-over-unbuilt-tlas", "traces",
   device.Destroy(never_built);
 }
 
+CORPUS_CASE(TracesBottomLevelDestroyed, "traces-bottom-level-destroyed-under-traced-tlas", "traces",
+            "a static scene whose bottom-level structure's handle is destroyed (its memory kept) while the top level "
+            "built over it is still traced by later ray-query dispatches, without a rebuild",
+            {"ASVAL-Traces-BottomLevelInvalid"}) {
+  RayScene scene(device);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Commands commands(device);
+  VkCommandBuffer build = commands.Begin();
+  scene.Build(commands, build);
+  commands.End(build);
+  vkkit::Check(commands.Submit(build), "vkQueueSubmit");
+  scene.blas.DestroyHandle();
+  VkCommandBuffer cb = commands.Begin();
+  program.Record(cb);
+  commands.End(cb);
+  commands.Submit(cb);  // a layer that reports it may keep it from the driver
+}
+
 }  // namespace corpus
