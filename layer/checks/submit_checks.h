@@ -13,12 +13,13 @@ namespace asval {
 
 class SubmitChecks {
  public:
-  explicit SubmitChecks(const CheckContext& ctx) : ctx_(ctx) {}
+  // submission: the HistorySubmission's id (SubmissionCaptures::id), which the operations are judged within.
+  SubmitChecks(const CheckContext& ctx, uint64_t submission = 0) : ctx_(ctx), submission_(submission) {}
 
   // The check for the operations of one submitted command buffer; loc names it in the call's parameters.
   auto For(VkCommandBuffer cb, const Location& loc) {
-    return [this, site = HistoryCheckSite{loc, cb, true}](const HistoryStore& store, const OpBatch& batch,
-                                                          const AsOp& op) {
+    return [this, site = HistoryCheckSite{loc, cb, true, submission_}](const HistoryStore& store, const OpBatch& batch,
+                                                                       const AsOp& op) {
       CheckOpHistory(ctx_.state, store, ctx_.enabled_checks, batch, op, site, findings_);
     };
   }
@@ -27,6 +28,7 @@ class SubmitChecks {
 
  private:
   const CheckContext& ctx_;
+  uint64_t submission_ = 0;
   HistoryFindings findings_;
 };
 

@@ -52,7 +52,12 @@ struct TracedJudge {
   // The bottom-level structures the top level's last build referenced are still alive (the same structures: serials).
   void JudgeReferenced(const TracedBinding& b, VkAccelerationStructureKHR top, const AsHistory& h) const {
     const std::shared_ptr<const ReferencedStructures> refs = h.activity ? h.activity->references() : nullptr;
-    if (!refs) return Skip(TracedSkip::kReferencesUnknown);
+    if (!refs) {
+      // Built earlier in this same submission: the host cannot have destroyed anything between that build and this
+      // trace, and the build's own references are judged when it completes (pInfos-06707). Otherwise not known yet.
+      if (h.activity && site.submission != 0 && h.activity->submission() == site.submission) return;
+      return Skip(TracedSkip::kReferencesUnknown);
+    }
     // No structure created or destroyed since the last walk found them all alive: they still are.
     const uint64_t structures_now = state.acceleration_structures.stamp().count + 1;
     if (refs->verified_structures.load(std::memory_order_relaxed) == structures_now) return;

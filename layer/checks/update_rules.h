@@ -24,6 +24,7 @@ struct HistoryCheckSite {
   Location loc;                                    // e.g. vkQueueSubmit(): pSubmits[0].pCommandBuffers[1]
   VkCommandBuffer submitted = VK_NULL_HANDLE;      // the command buffer submitted (null for host calls)
   bool describe_origin = false;                    // prefix messages with where the operation was recorded
+  uint64_t submission = 0;                         // SubmissionCaptures::id of the submission (0: host calls)
 };
 
 // Checks `op` against the histories as they are before it executes. Call with the store's lock held.

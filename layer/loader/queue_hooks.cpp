@@ -151,7 +151,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
     call.emplace(order, queue, function);
   }
   HistorySubmission submission(data.state);
-  SubmitChecks checks(ctx);
+  SubmitChecks checks(ctx, submission.captures().id);
   uint64_t unordered_batches = 0, unordered_ops = 0;
   for (uint32_t i = 0; i < batch_count; ++i) {
     const Placement place = call ? call->Place(semaphores_of(i)) : Placement::kNow;

@@ -98,6 +98,9 @@ class BuildActivity {
   std::shared_ptr<const ReferencedStructures> references() const {
     return std::atomic_load_explicit(&references_, std::memory_order_acquire);
   }
+  // The submission that applied this build (SubmissionCaptures::id; 0: none known).
+  uint64_t submission() const { return submission_; }
+  void SetSubmission(uint64_t id) { submission_ = id; }
   // The bytes cannot be trusted (the same capture written twice before it was read): unknown.
   void MarkUnknown() {
     status_.store(Status::kUnknown, std::memory_order_release);
@@ -129,6 +132,7 @@ class BuildActivity {
   OpOrigin origin_;
   VkAccelerationStructureKHR dst_ = VK_NULL_HANDLE;
   std::shared_ptr<const ReferencedStructures> references_;
+  uint64_t submission_ = 0;
 };
 
 // An update to compare with the activity of its source's last executed build (pInfos-03663, 03664, 03768).
@@ -208,6 +212,9 @@ struct DeserializeCheck {
 
 // What one submission's captures ask for once it completes, in submission order.
 struct SubmissionCaptures {
+  // This submission's id (device-wide unique, DeviceState::NextObjectId; 0: none): the activity records it creates
+  // carry it (BuildActivity::submission), so that a trace in the same submission knows a build pending beside it.
+  uint64_t id = 0;
   std::vector<std::shared_ptr<BuildActivity>> fills;
   std::vector<ActivityComparison> comparisons;
   std::vector<InstanceReferenceCheck> instance_checks;

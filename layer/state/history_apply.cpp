@@ -168,6 +168,7 @@ std::shared_ptr<BuildActivity> CapturedActivity(const DeviceState& state, const 
                                                 SubmissionCaptures& captures) {
   CaptureLog* log = op.capture_log;
   auto node = std::make_shared<BuildActivity>(log->shared_from_this(), op.capture_info, op.origin, op.dst);
+  node->SetSubmission(captures.id);
   const auto key = std::make_pair(static_cast<const CaptureLog*>(log), op.capture_info);
   auto [it, first] = captures.claimed.emplace(key, node.get());
   if (!first) {

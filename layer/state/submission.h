@@ -34,7 +34,10 @@ bool RecordedOf(const DeviceState& state, VkCommandBuffer cb, std::shared_ptr<co
 
 class HistorySubmission {
  public:
-  explicit HistorySubmission(DeviceState& state) : state_(state) { captures_.failures = &state.failures(); }
+  explicit HistorySubmission(DeviceState& state) : state_(state) {
+    captures_.failures = &state.failures();
+    captures_.id = state.NextObjectId();
+  }
   HistorySubmission(const HistorySubmission&) = delete;
   HistorySubmission& operator=(const HistorySubmission&) = delete;
   ~HistorySubmission();
