@@ -5,6 +5,7 @@
 #include <string>
 
 #include "build_report.h"
+#include "structure_memory.h"
 
 namespace asval {
 
@@ -49,7 +50,8 @@ struct TracedJudge {
     Report(b, d.as, built ? h : nullptr);
   }
 
-  // The bottom-level structures the top level's last build referenced are still alive (the same structures: serials).
+  // The bottom-level structures the top level's last build referenced are still the same live structures, their
+  // storage still bound, and not rebuilt since with another geometry layout.
   void JudgeReferenced(const TracedBinding& b, VkAccelerationStructureKHR top, const AsHistory& h) const {
     const std::shared_ptr<const ReferencedStructures> refs = h.activity ? h.activity->references() : nullptr;
     if (!refs) {
@@ -58,15 +60,35 @@ struct TracedJudge {
       if (h.activity && site.submission != 0 && h.activity->submission() == site.submission) return;
       return Skip(TracedSkip::kReferencesUnknown);
     }
-    // No structure created or destroyed since the last walk found them all alive: they still are.
-    const uint64_t structures_now = state.acceleration_structures.stamp().count + 1;
-    if (refs->verified_structures.load(std::memory_order_relaxed) == structures_now) return;
+    // Nothing that could change the answer happened since the last walk found nothing: no walk. Each stamp only
+    // grows, so their sum changes whenever one of them does.
+    const uint64_t stamps_now = state.acceleration_structures.stamp().count +
+                                state.structure_storage_changes.Read().count + store.bottom_layout_changes() + 1;
+    if (refs->verified_structures.load(std::memory_order_relaxed) == stamps_now) return;
+    bool found = false;
     for (const ReferencedStructures::Referenced& r : refs->structures) {
       const std::optional<std::shared_ptr<const AccelerationStructureState>> now =
           state.acceleration_structures.find(r.as);
-      if (!now || !*now || (*now)->serial != r.serial) return ReportReferenced(b, top, h, r.as, "was destroyed");
+      if (!now || !*now || (*now)->serial != r.serial) {
+        ReportReferenced(b, top, h, r.as, "was destroyed since");
+        found = true;
+        continue;
+      }
+      // A structure whose buffer was destroyed while its memory stays is not judged (engines relocate so).
+      if (StorageOfStructure(state, **now) == StructureStorage::kMemoryFreed) {
+        ReportReferenced(b, top, h, r.as, "is still alive, but the memory its buffer was bound to was freed since");
+        found = true;
+        continue;
+      }
+      const AsHistory* bottom = r.build ? store.Find(r.as) : nullptr;
+      // A later write of it (generation: an undone submission restores an older one, never judged).
+      if (bottom && bottom->kind == HistoryKind::kBuilt && bottom->build && bottom->build != r.build &&
+          bottom->generation > r.generation && !SameGeometryLayout(*r.build, *bottom->build)) {
+        ReportRebuilt(b, top, h, r, *bottom->build);
+        found = true;
+      }
     }
-    refs->verified_structures.store(structures_now, std::memory_order_relaxed);
+    if (!found) refs->verified_structures.store(stamps_now, std::memory_order_relaxed);
   }
 
   [[gnu::cold, gnu::noinline]] void ReportReferenced(const TracedBinding& b, VkAccelerationStructureKHR top,
@@ -76,11 +98,28 @@ struct TracedJudge {
             {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, top),
              Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, bottom)},
             fmt::format("{}: the bound pipeline's shaders read the top-level VkAccelerationStructureKHR {} ({}), whose "
-                        "last build ({}) referenced the bottom-level VkAccelerationStructureKHR {}, which {} since. "
+                        "last build ({}) referenced the bottom-level VkAccelerationStructureKHR {}, which {}. "
                         "Bottom-level structures must be valid when the top level is accessed: rebuild the top level "
                         "without it first.",
                         DescribeOrigin(op.origin), Hex(top), Through(b), DescribeOrigin(h.build->origin), Hex(bottom),
                         what));
+  }
+
+  [[gnu::cold, gnu::noinline]] void ReportRebuilt(const TracedBinding& b, VkAccelerationStructureKHR top,
+                                                  const AsHistory& h, const ReferencedStructures::Referenced& r,
+                                                  const BuildSnapshot& now) const {
+    out.Add(Severity::kWarning, kBottomLevelChangedId, site.loc,
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, top),
+             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, r.as)},
+            fmt::format("{}: the bound pipeline's shaders read the top-level VkAccelerationStructureKHR {} ({}), whose "
+                        "last build ({}) referenced the bottom-level VkAccelerationStructureKHR {} as {} built it "
+                        "({} geometries); {} has rebuilt it since with another geometry layout ({} geometries). The "
+                        "top level's instances still describe the old structure (bounds, geometry indices into the "
+                        "shader binding table): what traversal finds is not defined. Rebuild or update the top level "
+                        "after rebuilding a bottom level it references.",
+                        DescribeOrigin(op.origin), Hex(top), Through(b), DescribeOrigin(h.build->origin), Hex(r.as),
+                        DescribeOrigin(r.build->origin), r.build->geometries.size(), DescribeOrigin(now.origin),
+                        now.geometries.size()));
   }
 
   // built_bottom: the history of a structure whose last build made a bottom-level one; null: never built.

@@ -32,8 +32,12 @@ const char* TracedSkipName(TracedSkip skip);
 
 // Layer-specific (the chapter's "Those bottom level acceleration structure objects must be valid when the top level
 // acceleration structure is accessed" has no VUID): a traced top level's last build referenced a bottom-level
-// structure that was destroyed since.
+// structure that was destroyed since, or whose storage's memory was freed since.
 inline constexpr const char kBottomLevelInvalidId[] = "ASVAL-Traces-BottomLevelInvalid";
+// Layer-specific warning: a traced top level's last build referenced a bottom-level structure rebuilt since with
+// another geometry layout (count or types), and the top level was not built or updated after: the result is not
+// defined (the top level's instance data describe the old structure), not invalid.
+inline constexpr const char kBottomLevelChangedId[] = "ASVAL-Traces-BottomLevelChanged";
 
 // Judges one kTrace operation against the histories before it. Call with the store's lock held.
 void CheckTracedStructures(const DeviceState& state, const HistoryStore& store, const OpBatch& batch, const AsOp& op,

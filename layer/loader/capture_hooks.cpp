@@ -7,6 +7,7 @@
 
 #include "activity_rules.h"
 #include "capture_notices.h"
+#include "history_apply.h"
 #include "indirect_rules.h"
 #include "instance_rules.h"
 #include "layer_data.h"
@@ -38,6 +39,7 @@ void ProcessCaptures(DeviceData& data, const CaptureTracker::Covered& covered) {
           data.state.traces_tracked && build.activity && build.activity->status() != BuildActivity::Status::kUnknown;
       auto referenced = keep ? std::make_shared<ReferencedStructures>() : nullptr;
       if (CheckInstanceReferences(ctx, build, referenced.get()) && referenced) {
+        RememberReferencedBuilds(data.state.history.store, *referenced);
         build.activity->SetReferences(std::move(referenced));
       }
       ReportInstanceTransforms(ctx, build, warnings, spacing_permille);

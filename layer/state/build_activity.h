@@ -21,6 +21,8 @@
 
 namespace asval {
 
+struct BuildSnapshot;  // history.h (which includes this file)
+
 // The first NaN or infinite element of a 3x4 row-major float matrix as captured (VkTransformMatrixKHR, the
 // transform of an instance record), as row * 4 + column; -1 when all twelve are finite.
 int FirstNonFiniteElement(const uint8_t* matrix);
@@ -41,13 +43,18 @@ float FloatSpacingAt(float x);
 bool SpacingExceeds(float magnitude, float size, uint32_t permille);
 
 // The structures a top-level build's instances referenced (issue 29, family traces): each distinct one with its
-// serial (AccelerationStructureState::serial), as the capture found them when the build's submission completed.
-// A trace of the top level walks them to see that each is still alive; the structure map's change stamp (plus one)
-// at the last walk that found them all alive is kept, and while it reads the same no walk is needed (0: never).
+// serial (AccelerationStructureState::serial), as the capture found them when the build's submission completed,
+// and the build that had last executed on it then (its snapshot and history generation; null: not known). A trace
+// of the top level walks them to see that each is still alive, its storage still bound, and not rebuilt since with
+// another geometry layout. The sum of the change stamps that can alter that answer (structures created or destroyed,
+// storage bound or freed, bottom-level layouts replaced), plus one, at the last walk that found nothing is kept,
+// and while it reads the same no walk is needed (0: never).
 struct ReferencedStructures {
   struct Referenced {
     VkAccelerationStructureKHR as = VK_NULL_HANDLE;
     uint64_t serial = 0;
+    std::shared_ptr<const BuildSnapshot> build;
+    uint64_t generation = 0;
   };
   std::vector<Referenced> structures;
   mutable std::atomic<uint64_t> verified_structures{0};
@@ -159,8 +166,6 @@ struct InstanceReferenceCheck {
   // The build's activity node (the history's record of it): gets the structures the instances referenced.
   std::shared_ptr<BuildActivity> activity;
 };
-
-struct BuildSnapshot;  // history.h (which includes this file)
 
 // An indirect build whose range infos, read by the device, must respect ppMaxPrimitiveCounts (03653); for an
 // update, each geometry's primitiveCount must also be its source's last build's (primitiveCount-03769).

@@ -76,6 +76,14 @@ uint32_t HistoryStore::Insert(VkAccelerationStructureKHR as, AsHistory history, 
   return record;
 }
 
+bool SameGeometryLayout(const BuildSnapshot& a, const BuildSnapshot& b) {
+  if (a.geometries.size() != b.geometries.size()) return false;
+  for (std::size_t g = 0; g < a.geometries.size(); ++g) {
+    if (a.geometries[g].type != b.geometries[g].type) return false;
+  }
+  return true;
+}
+
 uint32_t HistoryStore::Set(VkAccelerationStructureKHR as, AsHistory history, Transaction* txn) {
   if (as == VK_NULL_HANDLE) return kNoRecord;  // not a structure: nothing can ask for its record
   const uint32_t record = RecordOf(as);
@@ -100,6 +108,7 @@ void HistoryStore::SetAt(uint32_t record, VkAccelerationStructureKHR as, AsHisto
   const bool moved = old_span.memory != history.span.memory || old_span.begin != history.span.begin ||
                      old_span.end != history.span.end;
   if (moved) Unindex(as, old_span);
+  NoteRewritten(r.history().build.get(), history.build.get());
   if (txn) {
     txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     txn->histories_.emplace_back(as, version, r.version, true, std::move(r.history()));
@@ -116,6 +125,7 @@ AsHistory& HistoryStore::RewriteInPlace(uint32_t record, VkAccelerationStructure
   Record& r = records_[record];
   const uint64_t version = ++version_counter_;
   AsHistory& h = r.history();
+  NoteRewritten(h.build.get(), build.get());
   if (txn) {
     txn->entries_.reserve(txn->entries_.size() + 1);  // so that the entry never names a change that failed
     txn->histories_.emplace_back(as, version, r.version, true, std::move(h));  // leaves the span as it was

@@ -43,6 +43,10 @@ struct BuildSnapshot {
   OpOrigin origin;  // the build (or update) that produced it
 };
 
+// Whether two builds made structures of the same geometry layout: as many geometries, of the same types in the
+// same order (what a top level's instances index their shader binding table records by).
+bool SameGeometryLayout(const BuildSnapshot& a, const BuildSnapshot& b);
+
 enum class HistoryKind : uint8_t { kNeverBuilt, kBuilt, kUnknown };
 
 enum class UnknownReason : uint8_t {
@@ -203,6 +207,7 @@ class HistoryStore {
     r.current ^= 1;
     r.flipped_by = txn->id_;
     r.version = version;
+    NoteRewritten(r.slots[r.current ^ 1].build.get(), build.get());
     ResetForRewrite(h, build);
     return h;
   }
@@ -215,6 +220,10 @@ class HistoryStore {
   // Destroyed: its history ends; a new structure with the same handle value starts fresh.
   void Forget(VkAccelerationStructureKHR as);
   uint64_t NextGeneration() { return ++generation_counter_; }
+  // How many times a bottom-level structure's contents were replaced by a build of another geometry layout
+  // (SameGeometryLayout; a rebuild, a copy or a deserialization over it). A top level's trace (family traces)
+  // walks the bottom levels its last build referenced only when this, or the structures, changed since.
+  uint64_t bottom_layout_changes() const { return bottom_layout_changes_; }
 
   // Structures whose span overlaps `span` (other than `except`).
   template <typename F>
@@ -316,6 +325,13 @@ class HistoryStore {
   void Push(Transaction* txn, Transaction::Kind kind, uint64_t blob_id);
   AsHistory& RewriteInPlace(uint32_t record, VkAccelerationStructureKHR as, Transaction* txn,
                             const std::shared_ptr<const BuildSnapshot>& build);
+  // Counts a bottom level's contents replaced by a build of another layout (before, after: their builds' snapshots).
+  void NoteRewritten(const BuildSnapshot* before, const BuildSnapshot* after) {
+    if (before == after || !before || !after) return;  // most rewrites keep their snapshot: one compare
+    if (before->type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR && !SameGeometryLayout(*before, *after)) {
+      ++bottom_layout_changes_;
+    }
+  }
   void ResetForRewrite(AsHistory& h, const std::shared_ptr<const BuildSnapshot>& build) {
     h.kind = HistoryKind::kNeverBuilt;
     h.unknown_reason = UnknownReason::kNone;
@@ -342,6 +358,7 @@ class HistoryStore {
   std::vector<SerializedBlob> blobs_;
   std::unordered_map<std::pair<VkQueryPool, uint32_t>, SlotRecord, SlotKeyHash> slots_;
   uint64_t generation_counter_ = 0;
+  uint64_t bottom_layout_changes_ = 0;
   uint64_t version_counter_ = 0;
   uint64_t blob_counter_ = 0;
   std::size_t peak_records_ = 0, peak_blobs_ = 0, peak_query_slots_ = 0;  // Sizes

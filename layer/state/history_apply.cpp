@@ -490,6 +490,16 @@ void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch
   }
 }
 
+void RememberReferencedBuilds(const HistoryStore& store, ReferencedStructures& references) {
+  const std::unique_lock<std::mutex> lock = store.Lock();
+  for (ReferencedStructures::Referenced& r : references.structures) {
+    const AsHistory* h = store.Find(r.as);
+    if (!h || h->kind != HistoryKind::kBuilt) continue;  // not known: no rebuild is judged against it
+    r.build = h->build;
+    r.generation = h->generation;
+  }
+}
+
 void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size) {
   const AsHistory* current = store.Find(as);
   if (!current || current->generation != generation || generation == 0) return;  // rebuilt since: stale

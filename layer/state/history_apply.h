@@ -33,6 +33,11 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
 // reached unknown and the rest as it was (counted as one more allocation failure); never throws.
 void MakeAllUnknownAfterFailure(const DeviceState& state, HistoryStore& store);
 
+// A top-level build's references, found when its submission completed (family traces): each referenced structure
+// gets the build that last executed on it as the store holds it now, to tell a later rebuild of another layout
+// from it. Takes the store's lock itself (the capture processing lock may be held).
+void RememberReferencedBuilds(const HistoryStore& store, ReferencedStructures& references);
+
 // Serialization sizes read back on the host (vkWriteAccelerationStructuresPropertiesKHR, or a query result
 // fetched with vkGetQueryPoolResults) for the structure's current contents.
 void RecordSerializationSize(HistoryStore& store, VkAccelerationStructureKHR as, uint64_t generation, uint64_t size);

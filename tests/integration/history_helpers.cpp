@@ -255,6 +255,11 @@ void Blas::DestroyStorageBuffer() {
   storage_.buffer = VK_NULL_HANDLE;  // ~Blas frees the memory only
 }
 
+void Blas::FreeStorageMemory() {
+  if (storage_.memory) vkFreeMemory(device_.handle(), storage_.memory, nullptr);
+  storage_.memory = VK_NULL_HANDLE;  // ~Blas destroys the buffer only
+}
+
 VkAccelerationStructureKHR Blas::Relocate() {
   if (!storage_.memory) throw std::logic_error("Blas::Relocate needs a structure with storage of its own");
   const VkAccelerationStructureKHR old = handle_;

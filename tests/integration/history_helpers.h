@@ -155,6 +155,8 @@ class Blas {
   // Destroys the VkBuffer the structure was created on (its own storage), not its memory nor the structure: the
   // handle stays alive on a buffer that is gone, address() stays backed by the same memory.
   void DestroyStorageBuffer();
+  // Frees the memory the structure's own storage buffer is bound to; the structure and the buffer stay alive.
+  void FreeStorageMemory();
   // Deferred deletion, as engines do it: destroys the VkBuffer the structure was created on while its handle is
   // kept (returned: the caller destroys it later), binds a new buffer to the same memory at the same offset and
   // creates a new, unbuilt structure there, which gets the old one's address (on lavapipe a buffer's address is its

@@ -2,6 +2,7 @@
 // execution order. The firing cases are skipped by the monitor's VK_TRUE, so no invalid work reaches lavapipe; the
 // valid twins run on it, are waited for, and must compute the ray's hit (the layer changes nothing the app computes).
 #include <catch2/catch_test_macros.hpp>
+#include <functional>
 
 #include "ray_program.h"
 
@@ -221,6 +222,119 @@ TEST_CASE("traces valid twin: a bottom level destroyed once the traced top level
   CHECK(program.hit() == 1u);
   device.Destroy(instances);
   device.Destroy(third_instances);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "traces: a traced top level whose last build referenced a bottom level whose memory was freed since is reported "
+    "(ASVAL-Traces-BottomLevelInvalid)",
+    "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  scene.blas.FreeStorageMemory();  // the structure and its buffer stay alive
+  f.monitor().Expect("ASVAL-Traces-BottomLevelInvalid");
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));  // skipped (VK_TRUE)
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("traces valid twin: a bottom level's memory freed once the traced top level was rebuilt without it",
+          "[integration][traces]") {
+  HistoryFixture f(nullptr, {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Blas replacement(device, scene.inputs);
+  vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+    replacement.Build(c, Shape{});
+    commands.Barrier(c);
+    scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  })) == VK_SUCCESS);
+  scene.blas.FreeStorageMemory();  // alive, unreferenced: its memory may go
+  program.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); })) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  device.Destroy(instances);
+  CHECK(f.monitor().Verify() == "");
+}
+
+Shape TwoGeometries() {
+  Shape shape;
+  shape.geometries = 2;
+  return shape;
+}
+
+TEST_CASE(
+    "traces: a traced top level whose bottom level was rebuilt since with another geometry count warns "
+    "(ASVAL-Traces-BottomLevelChanged)",
+    "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  // The bottom level rebuilt with two geometries; the top level, built over its one geometry, is not rebuilt.
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.blas.Build(c, TwoGeometries()); })) ==
+          VK_SUCCESS);
+  f.monitor().Expect("ASVAL-Traces-BottomLevelChanged");
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));
+  CHECK(f.monitor().Verify() == "");
+  // A rebuild with three geometries in the command buffer of the query, before it: warned in execution order.
+  Shape three;
+  three.geometries = 3;
+  f.monitor().Expect("ASVAL-Traces-BottomLevelChanged");
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+    scene.blas.Build(c, three);
+    commands.Barrier(c);
+    program.Record(c);
+  }));
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "traces valid twin: a bottom level refitted, rebuilt with the same layout, or rebuilt before the top level stays "
+    "silent",
+    "[integration][traces]") {
+  HistoryFixture f(nullptr, {}, RayDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  const auto query = [&](const std::function<void(VkCommandBuffer)>& before) {
+    program.Clear();
+    REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+      before(c);
+      program.BarrierAfterBuild(c);
+      program.Record(c);
+    })) == VK_SUCCESS);
+    CHECK(program.hit() == 1u);
+  };
+  // Refitted (an update keeps the geometries), then rebuilt with the same layout, without the top level.
+  query([&](VkCommandBuffer c) { scene.blas.Update(c, Shape{}); });
+  query([&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); });
+  // Rebuilt with two geometries and the top level rebuilt after it, in one submission and in two.
+  query([&](VkCommandBuffer c) {
+    scene.blas.Build(c, TwoGeometries());
+    commands.Barrier(c);
+    scene.tlas.Record(c, scene.instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  });
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); })) == VK_SUCCESS);
+  query([&](VkCommandBuffer c) {
+    scene.tlas.Record(c, scene.instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  });
+  query([](VkCommandBuffer) {});
   CHECK(f.monitor().Verify() == "");
 }
 
