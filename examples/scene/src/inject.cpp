@@ -107,6 +107,7 @@ class Injector {
   void QueryWithoutCompaction();
   void ScratchDestroyedPending();
   void TracedUnbuilt();
+  void TracedBlasDestroyed();
 
   Scene& s_;
   Gpu& gpu_;
@@ -134,6 +135,7 @@ void Injector::Run() {
     case FaultId::kQueryWithoutCompaction: return QueryWithoutCompaction();
     case FaultId::kScratchDestroyedPending: return ScratchDestroyedPending();
     case FaultId::kTracedUnbuilt: return TracedUnbuilt();
+    case FaultId::kTracedBlasDestroyed: return TracedBlasDestroyed();
   }
 }
 
@@ -385,6 +387,28 @@ void Injector::TracedUnbuilt() {
   RecordAndSubmit([&](VkCommandBuffer cb) { s_.tracer.RecordTrace(cb); });
   s_.tracer.SetScene(top.handle);
   gpu_.vk().DestroyAccelerationStructureKHR(gpu_.device(), unbuilt, nullptr);
+}
+
+void Injector::TracedBlasDestroyed() {
+  // A spare bottom level (the ground, built again), referenced by one instance of a valid top-level rebuild that
+  // completes; then the spare's handle is destroyed while its memory stays allocated, and the frame is traced: the
+  // top level's instance still names the destroyed structure, whose bytes a driver that ran the trace would find.
+  const BuildInput& ground = s_.statics.input(StaticBlases::kGround);
+  const VkAccelerationStructureBuildSizesInfoKHR sizes = ground.QuerySizes(gpu_);
+  AccelerationStructure& spare =
+      pad_.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize, "spare");
+  const Buffer& scratch = pad_.NewScratch(sizes.buildScratchSize);
+  RecordAndSubmit([&](VkCommandBuffer cb) { BuildInto(cb, ground, spare.handle, scratch.address); });
+
+  s_.top.WriteInstances(parity_, Scene::TimeOf(s_.frames_done()));
+  VkAccelerationStructureInstanceKHR* instances = s_.top.instances(parity_);
+  uint32_t victim = 1;
+  while (victim < s_.top.count() && instances[victim].accelerationStructureReference == 0) ++victim;
+  instances[victim].accelerationStructureReference = spare.address;
+  RecordAndSubmit([&](VkCommandBuffer cb) { s_.top.RecordBuild(cb, parity_, kBuild); });  // valid, waited for
+  gpu_.DestroyHandle(spare);
+  std::printf("fault: tracing a top level whose instance %u references a bottom level destroyed since\n", victim);
+  RecordAndSubmit([&](VkCommandBuffer cb) { s_.tracer.RecordTrace(cb); });
 }
 
 }  // namespace scene
