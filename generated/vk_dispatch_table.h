@@ -46,6 +46,18 @@ struct DeviceDispatchTable {
   PFN_vkCmdDispatch CmdDispatch = nullptr;
   PFN_vkCmdDispatchBase CmdDispatchBase = nullptr;
   PFN_vkCmdDispatchIndirect CmdDispatchIndirect = nullptr;
+  PFN_vkCmdDraw CmdDraw = nullptr;
+  PFN_vkCmdDrawIndexed CmdDrawIndexed = nullptr;
+  PFN_vkCmdDrawIndexedIndirect CmdDrawIndexedIndirect = nullptr;
+  PFN_vkCmdDrawIndexedIndirectCount CmdDrawIndexedIndirectCount = nullptr;
+  PFN_vkCmdDrawIndirect CmdDrawIndirect = nullptr;
+  PFN_vkCmdDrawIndirectByteCountEXT CmdDrawIndirectByteCountEXT = nullptr;
+  PFN_vkCmdDrawIndirectCount CmdDrawIndirectCount = nullptr;
+  PFN_vkCmdDrawMeshTasksEXT CmdDrawMeshTasksEXT = nullptr;
+  PFN_vkCmdDrawMeshTasksIndirectCountEXT CmdDrawMeshTasksIndirectCountEXT = nullptr;
+  PFN_vkCmdDrawMeshTasksIndirectEXT CmdDrawMeshTasksIndirectEXT = nullptr;
+  PFN_vkCmdDrawMultiEXT CmdDrawMultiEXT = nullptr;
+  PFN_vkCmdDrawMultiIndexedEXT CmdDrawMultiIndexedEXT = nullptr;
   PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
   PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
   PFN_vkCmdPipelineBarrier2 CmdPipelineBarrier2 = nullptr;
@@ -72,6 +84,7 @@ struct DeviceDispatchTable {
   PFN_vkCreateDescriptorUpdateTemplate CreateDescriptorUpdateTemplate = nullptr;
   PFN_vkCreateEvent CreateEvent = nullptr;
   PFN_vkCreateFence CreateFence = nullptr;
+  PFN_vkCreateGraphicsPipelines CreateGraphicsPipelines = nullptr;
   PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
   PFN_vkCreateQueryPool CreateQueryPool = nullptr;
   PFN_vkCreateRayTracingPipelinesKHR CreateRayTracingPipelinesKHR = nullptr;

@@ -30,6 +30,22 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdDispatchBase",
     "vkCmdDispatchBaseKHR",
     "vkCmdDispatchIndirect",
+    "vkCmdDraw",
+    "vkCmdDrawIndexed",
+    "vkCmdDrawIndexedIndirect",
+    "vkCmdDrawIndexedIndirectCount",
+    "vkCmdDrawIndexedIndirectCountAMD",
+    "vkCmdDrawIndexedIndirectCountKHR",
+    "vkCmdDrawIndirect",
+    "vkCmdDrawIndirectByteCountEXT",
+    "vkCmdDrawIndirectCount",
+    "vkCmdDrawIndirectCountAMD",
+    "vkCmdDrawIndirectCountKHR",
+    "vkCmdDrawMeshTasksEXT",
+    "vkCmdDrawMeshTasksIndirectCountEXT",
+    "vkCmdDrawMeshTasksIndirectEXT",
+    "vkCmdDrawMultiEXT",
+    "vkCmdDrawMultiIndexedEXT",
     "vkCmdExecuteCommands",
     "vkCmdPipelineBarrier",
     "vkCmdPipelineBarrier2",
@@ -61,6 +77,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateDescriptorUpdateTemplate",
     "vkCreateDescriptorUpdateTemplateKHR",
     "vkCreateDevice",
+    "vkCreateGraphicsPipelines",
     "vkCreateInstance",
     "vkCreateQueryPool",
     "vkCreateRayTracingPipelinesKHR",
@@ -145,6 +162,22 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdDispatchBase
     true,  // vkCmdDispatchBaseKHR
     true,  // vkCmdDispatchIndirect
+    true,  // vkCmdDraw
+    true,  // vkCmdDrawIndexed
+    true,  // vkCmdDrawIndexedIndirect
+    true,  // vkCmdDrawIndexedIndirectCount
+    true,  // vkCmdDrawIndexedIndirectCountAMD
+    true,  // vkCmdDrawIndexedIndirectCountKHR
+    true,  // vkCmdDrawIndirect
+    true,  // vkCmdDrawIndirectByteCountEXT
+    true,  // vkCmdDrawIndirectCount
+    true,  // vkCmdDrawIndirectCountAMD
+    true,  // vkCmdDrawIndirectCountKHR
+    true,  // vkCmdDrawMeshTasksEXT
+    true,  // vkCmdDrawMeshTasksIndirectCountEXT
+    true,  // vkCmdDrawMeshTasksIndirectEXT
+    true,  // vkCmdDrawMultiEXT
+    true,  // vkCmdDrawMultiIndexedEXT
     true,  // vkCmdExecuteCommands
     true,  // vkCmdPipelineBarrier
     true,  // vkCmdPipelineBarrier2
@@ -176,6 +209,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCreateDescriptorUpdateTemplate
     true,  // vkCreateDescriptorUpdateTemplateKHR
     false,  // vkCreateDevice
+    true,  // vkCreateGraphicsPipelines
     false,  // vkCreateInstance
     true,  // vkCreateQueryPool
     true,  // vkCreateRayTracingPipelinesKHR

@@ -210,8 +210,7 @@ void ReportTracesSummary(const DeviceState& state, Reporter& reporter, VkDevice 
       judged);
   for (const NamedCount& r : reasons) text += fmt::format(" {}={}", r.name, r.count);
   text +=
-      ". Structures a shader reaches from a device address (OpConvertUToAccelerationStructureKHR) and ray queries in "
-      "draws are not followed.";
+      ". Structures a shader reaches from a device address (OpConvertUToAccelerationStructureKHR) are not followed.";
   const NamedCounts counts{"traces_skipped", reasons, kReasons};
   const Location where("vkDestroyDevice");
   if (skipped != 0) {

@@ -1,6 +1,6 @@
 #pragma once
 // Family "traces" (issue 29): the top-level structures that trace and ray-query work reads are built, in execution
-// order. At submission each vkCmdTraceRays* and vkCmdDispatch* whose bound pipeline statically uses structure
+// order. At submission each vkCmdTraceRays*, vkCmdDispatch* and vkCmdDraw* whose bound pipeline statically uses structure
 // descriptors (shader_structure_use.h) is judged, just before it executes in the submission's order: every
 // structure in those descriptors (the set bound at that set number when the command was recorded, read as it is at
 // submission; or the structures pushed there) must have had a build execute on it, and that build must have made a
@@ -11,7 +11,7 @@
 // descriptors the layer cannot read (push templates, descriptor buffers, writes past a binding's end), a structure
 // the layer did not know when written or destroyed since (a handle is not an identity), unknown histories.
 // Structures a shader reaches from an address (OpConvertUToAccelerationStructureKHR) cannot be seen: nothing is
-// judged or counted for them. Draws are not followed (ray queries in graphics pipelines).
+// judged or counted for them. Draws are judged like dispatches (ray queries in graphics and mesh pipelines).
 #include "device_state.h"
 #include "history_findings.h"
 #include "update_rules.h"

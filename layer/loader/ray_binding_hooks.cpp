@@ -37,6 +37,18 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateComputePipelines(VkDevice device, VkPipelin
   return result;
 }
 
+VKAPI_ATTR VkResult VKAPI_CALL CreateGraphicsPipelines(VkDevice device, VkPipelineCache pipelineCache,
+                                                       uint32_t createInfoCount,
+                                                       const VkGraphicsPipelineCreateInfo* pCreateInfos,
+                                                       const VkAllocationCallbacks* pAllocator,
+                                                       VkPipeline* pPipelines) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreateGraphicsPipelines(device, pipelineCache, createInfoCount, pCreateInfos,
+                                                                 pAllocator, pPipelines);
+  if (result >= VK_SUCCESS) RecordCreateGraphicsPipelines(data->state, createInfoCount, pCreateInfos, pPipelines);
+  return result;
+}
+
 // A deferred creation (VK_OPERATION_DEFERRED_KHR) writes its handles when the operation completes: not followed.
 VKAPI_ATTR VkResult VKAPI_CALL CreateRayTracingPipelinesKHR(VkDevice device, VkDeferredOperationKHR deferredOperation,
                                                             VkPipelineCache pipelineCache, uint32_t createInfoCount,
@@ -225,6 +237,106 @@ VKAPI_ATTR void VKAPI_CALL CmdTraceRaysIndirect2KHR(VkCommandBuffer commandBuffe
   DeviceData* data = GetDeviceData(commandBuffer);
   data->dispatch.CmdTraceRaysIndirect2KHR(commandBuffer, indirectDeviceAddress);
   RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdTraceRaysIndirect2);
+}
+
+// Draws: ray queries in graphics and mesh pipelines.
+VKAPI_ATTR void VKAPI_CALL CmdDraw(VkCommandBuffer commandBuffer, uint32_t vertexCount, uint32_t instanceCount,
+                                   uint32_t firstVertex, uint32_t firstInstance) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDraw(commandBuffer, vertexCount, instanceCount, firstVertex, firstInstance);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDraw);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndexed(VkCommandBuffer commandBuffer, uint32_t indexCount, uint32_t instanceCount,
+                                          uint32_t firstIndex, int32_t vertexOffset, uint32_t firstInstance) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndexed(commandBuffer, indexCount, instanceCount, firstIndex, vertexOffset, firstInstance);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndexed);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndirect(VkCommandBuffer commandBuffer, VkBuffer buffer, VkDeviceSize offset,
+                                           uint32_t drawCount, uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndirect(commandBuffer, buffer, offset, drawCount, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndirect);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndexedIndirect(VkCommandBuffer commandBuffer, VkBuffer buffer, VkDeviceSize offset,
+                                                  uint32_t drawCount, uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndexedIndirect(commandBuffer, buffer, offset, drawCount, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndexedIndirect);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndirectCount(VkCommandBuffer commandBuffer, VkBuffer buffer, VkDeviceSize offset,
+                                                VkBuffer countBuffer, VkDeviceSize countBufferOffset,
+                                                uint32_t maxDrawCount, uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndirectCount(commandBuffer, buffer, offset, countBuffer, countBufferOffset, maxDrawCount,
+                                      stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndirectCount);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndexedIndirectCount(VkCommandBuffer commandBuffer, VkBuffer buffer,
+                                                       VkDeviceSize offset, VkBuffer countBuffer,
+                                                       VkDeviceSize countBufferOffset, uint32_t maxDrawCount,
+                                                       uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndexedIndirectCount(commandBuffer, buffer, offset, countBuffer, countBufferOffset,
+                                             maxDrawCount, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndexedIndirectCount);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawMultiEXT(VkCommandBuffer commandBuffer, uint32_t drawCount,
+                                           const VkMultiDrawInfoEXT* pVertexInfo, uint32_t instanceCount,
+                                           uint32_t firstInstance, uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawMultiEXT(commandBuffer, drawCount, pVertexInfo, instanceCount, firstInstance, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawMultiEXT);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawMultiIndexedEXT(VkCommandBuffer commandBuffer, uint32_t drawCount,
+                                                  const VkMultiDrawIndexedInfoEXT* pIndexInfo, uint32_t instanceCount,
+                                                  uint32_t firstInstance, uint32_t stride,
+                                                  const int32_t* pVertexOffset) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawMultiIndexedEXT(commandBuffer, drawCount, pIndexInfo, instanceCount, firstInstance, stride,
+                                        pVertexOffset);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawMultiIndexedEXT);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawIndirectByteCountEXT(VkCommandBuffer commandBuffer, uint32_t instanceCount,
+                                                       uint32_t firstInstance, VkBuffer counterBuffer,
+                                                       VkDeviceSize counterBufferOffset, uint32_t counterOffset,
+                                                       uint32_t vertexStride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawIndirectByteCountEXT(commandBuffer, instanceCount, firstInstance, counterBuffer,
+                                             counterBufferOffset, counterOffset, vertexStride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawIndirectByteCountEXT);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawMeshTasksEXT(VkCommandBuffer commandBuffer, uint32_t groupCountX,
+                                               uint32_t groupCountY, uint32_t groupCountZ) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawMeshTasksEXT(commandBuffer, groupCountX, groupCountY, groupCountZ);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawMeshTasksEXT);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawMeshTasksIndirectEXT(VkCommandBuffer commandBuffer, VkBuffer buffer,
+                                                       VkDeviceSize offset, uint32_t drawCount, uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawMeshTasksIndirectEXT(commandBuffer, buffer, offset, drawCount, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawMeshTasksIndirectEXT);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdDrawMeshTasksIndirectCountEXT(VkCommandBuffer commandBuffer, VkBuffer buffer,
+                                                            VkDeviceSize offset, VkBuffer countBuffer,
+                                                            VkDeviceSize countBufferOffset, uint32_t maxDrawCount,
+                                                            uint32_t stride) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdDrawMeshTasksIndirectCountEXT(commandBuffer, buffer, offset, countBuffer, countBufferOffset,
+                                                  maxDrawCount, stride);
+  RecordTraceCommand(data->state, commandBuffer, OpCommand::kCmdDrawMeshTasksIndirectCountEXT);
 }
 
 }  // namespace asval::hooks

@@ -1,9 +1,9 @@
 #pragma once
 // What a command buffer's recording has bound for trace and ray-query work (issue 29, family traces): per bind
-// point (compute, ray tracing), the pipeline when it reads structure descriptors, the descriptor sets bound at each
-// set number and the structures pushed there. Written by the recording thread only (CommandBufferState); tracked
-// only while some pipeline of the device reads structures (RayBindings::any_pipeline). A trace or dispatch turns it
-// into the TracedBinding records of its kTrace operation (MakeTraced).
+// point (compute, ray tracing, graphics), the pipeline when it reads structure descriptors, the descriptor sets bound
+// at each set number and the structures pushed there. Written by the recording thread only (CommandBufferState);
+// tracked only while some pipeline of the device reads structures (RayBindings::any_pipeline). A trace or dispatch
+// turns it into the TracedBinding records of its kTrace operation (MakeTraced).
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -17,11 +17,12 @@ namespace asval {
 
 class BoundStructures {
  public:
-  enum Point : uint8_t { kCompute, kRayTracing, kPointCount };
-  // The point of a bind point the family follows; kPointCount for graphics (draws are not followed).
+  enum Point : uint8_t { kCompute, kRayTracing, kGraphics, kPointCount };
+  // The point of a bind point the family follows; kPointCount for others (subpass shading, ...).
   static Point PointOf(VkPipelineBindPoint bind_point) {
     if (bind_point == VK_PIPELINE_BIND_POINT_COMPUTE) return kCompute;
     if (bind_point == VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR) return kRayTracing;
+    if (bind_point == VK_PIPELINE_BIND_POINT_GRAPHICS) return kGraphics;
     return kPointCount;
   }
 

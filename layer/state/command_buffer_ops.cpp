@@ -27,6 +27,18 @@ const char* OpCommandName(OpCommand command) {
     case OpCommand::kCmdDispatch: return "vkCmdDispatch";
     case OpCommand::kCmdDispatchIndirect: return "vkCmdDispatchIndirect";
     case OpCommand::kCmdDispatchBase: return "vkCmdDispatchBase";
+    case OpCommand::kCmdDraw: return "vkCmdDraw";
+    case OpCommand::kCmdDrawIndexed: return "vkCmdDrawIndexed";
+    case OpCommand::kCmdDrawIndirect: return "vkCmdDrawIndirect";
+    case OpCommand::kCmdDrawIndexedIndirect: return "vkCmdDrawIndexedIndirect";
+    case OpCommand::kCmdDrawIndirectCount: return "vkCmdDrawIndirectCount";
+    case OpCommand::kCmdDrawIndexedIndirectCount: return "vkCmdDrawIndexedIndirectCount";
+    case OpCommand::kCmdDrawMultiEXT: return "vkCmdDrawMultiEXT";
+    case OpCommand::kCmdDrawMultiIndexedEXT: return "vkCmdDrawMultiIndexedEXT";
+    case OpCommand::kCmdDrawIndirectByteCountEXT: return "vkCmdDrawIndirectByteCountEXT";
+    case OpCommand::kCmdDrawMeshTasksEXT: return "vkCmdDrawMeshTasksEXT";
+    case OpCommand::kCmdDrawMeshTasksIndirectEXT: return "vkCmdDrawMeshTasksIndirectEXT";
+    case OpCommand::kCmdDrawMeshTasksIndirectCountEXT: return "vkCmdDrawMeshTasksIndirectCountEXT";
     case OpCommand::kCount: break;
   }
   return "?";

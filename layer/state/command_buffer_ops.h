@@ -43,6 +43,19 @@ enum class OpCommand : uint8_t {
   kCmdDispatch,
   kCmdDispatchIndirect,
   kCmdDispatchBase,
+  // Draws: ray queries in graphics (and mesh) pipelines.
+  kCmdDraw,
+  kCmdDrawIndexed,
+  kCmdDrawIndirect,
+  kCmdDrawIndexedIndirect,
+  kCmdDrawIndirectCount,
+  kCmdDrawIndexedIndirectCount,
+  kCmdDrawMultiEXT,
+  kCmdDrawMultiIndexedEXT,
+  kCmdDrawIndirectByteCountEXT,
+  kCmdDrawMeshTasksEXT,
+  kCmdDrawMeshTasksIndirectEXT,
+  kCmdDrawMeshTasksIndirectCountEXT,
   kCount
 };
 constexpr std::size_t kOpCommandCount = static_cast<std::size_t>(OpCommand::kCount);

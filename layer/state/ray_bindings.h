@@ -64,6 +64,8 @@ class RayBindings {
   }
   // Some pipeline reads structures: command buffers track what they bind.
   bool any_pipeline() const { return pipeline_count_.load(std::memory_order_acquire) != 0; }
+  // Bumped after every pipeline kept or forgotten: a memo of Pipeline() answers read under an equal stamp is exact.
+  StampValue pipelines_stamp() const { return pipelines_.stamp(); }
 
   // ---- descriptor set layouts, update templates, sets ----
   // A layout's bindings of type VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR (or mutable types that may hold one).

@@ -1,6 +1,10 @@
 #include "ray_recorder.h"
 
+#include <array>
+#include <cstdint>
 #include <new>
+
+#include "history_recorder.h"
 
 namespace asval {
 
@@ -40,10 +44,49 @@ void Keep(DeviceState& state, VkPipeline pipeline, PipelineStructureUse use, VkP
   state.ray_bindings.AddPipeline(pipeline, std::make_shared<const PipelineStructureUse>(std::move(use)));
 }
 
-// The recording of cb while traces are followed and some pipeline reads structures; null otherwise.
-std::shared_ptr<CommandBufferState> Following(DeviceState& state, VkCommandBuffer cb) {
+// The recording of cb while traces are followed and some pipeline reads structures; null otherwise. Through the
+// thread's memo of the last command buffer it looked up (LastRecordedBuild, history_recorder.h: valid while the
+// command-buffer map's stamp reads the same, and for the call): binds and draws come by the thousand per frame, and
+// a map lookup each would cost more than the rest of the hook.
+CommandBufferState* Following(DeviceState& state, VkCommandBuffer cb) {
   if (!state.traces_tracked || !state.ray_bindings.any_pipeline()) return nullptr;
-  return state.command_buffers.Find(cb);
+  thread_local LastRecordedBuild last;
+  const StampValue stamp = state.command_buffers.stamp();
+  if (last.cb != cb || last.stamp != stamp) last = LastRecordedBuild{stamp, cb, state.command_buffers.Find(cb).get()};
+  return last.state;
+}
+
+// What a bound pipeline reads (null: no structure). Binds come by the thousand per frame: through the thread's small
+// table of the pipelines it looked up, each with the stamp of the map of pipelines that read structures when it was
+// looked up (read before the lookup, so a pipeline kept or forgotten meanwhile makes the entry stale, never wrong).
+std::shared_ptr<const PipelineStructureUse> PipelineUse(const DeviceState& state, VkPipeline pipeline) {
+  struct Entry {
+    StampValue stamp;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    std::shared_ptr<const PipelineStructureUse> use;
+  };
+  constexpr unsigned kBits = 6;
+  thread_local std::array<Entry, 1u << kBits> memo;
+  const StampValue stamp = state.ray_bindings.pipelines_stamp();
+  Entry& e = memo[(reinterpret_cast<uint64_t>(pipeline) * 0x9e3779b97f4a7c15ull) >> (64 - kBits)];
+  if (e.pipeline != pipeline || e.stamp != stamp) e = Entry{stamp, pipeline, state.ray_bindings.Pipeline(pipeline)};
+  return e.use;
+}
+
+// The bind point whose pipeline a trace, dispatch or draw runs.
+BoundStructures::Point PointOfCommand(OpCommand command) {
+  switch (command) {
+    case OpCommand::kCmdTraceRays:
+    case OpCommand::kCmdTraceRaysIndirect:
+    case OpCommand::kCmdTraceRaysIndirect2:
+      return BoundStructures::kRayTracing;
+    case OpCommand::kCmdDispatch:
+    case OpCommand::kCmdDispatchIndirect:
+    case OpCommand::kCmdDispatchBase:
+      return BoundStructures::kCompute;
+    default:
+      return BoundStructures::kGraphics;
+  }
 }
 
 // The object creations and descriptor updates allocate; a failure leaves the object unfollowed (its traces are
@@ -96,6 +139,31 @@ void RecordCreateRayTracingPipelines(DeviceState& state, uint32_t count, const V
         if (auto library = state.ray_bindings.Pipeline(info.pLibraryInfo->pLibraries[l])) {
           use.use.Merge(library->use);
           use.partly_unknown |= library->partly_unknown;
+        }
+      }
+      Keep(state, pipelines[i], std::move(use), info.flags);
+    }
+  });
+}
+
+void RecordCreateGraphicsPipelines(DeviceState& state, uint32_t count, const VkGraphicsPipelineCreateInfo* infos,
+                                   const VkPipeline* pipelines) {
+  if (!state.traces_tracked || !infos || !pipelines) return;
+  Guarded(state, [&] {
+    for (uint32_t i = 0; i < count; ++i) {
+      const VkGraphicsPipelineCreateInfo& info = infos[i];
+      PipelineStructureUse use;
+      for (uint32_t s = 0; info.pStages && s < info.stageCount; ++s) MergeStage(state, info.pStages[s], use);
+      // Graphics pipeline libraries (VK_EXT_graphics_pipeline_library) linked into it: pipelines created through
+      // this layer, their uses kept (none kept: they read none).
+      for (auto* s = static_cast<const VkBaseInStructure*>(info.pNext); s; s = s->pNext) {
+        if (s->sType != VK_STRUCTURE_TYPE_PIPELINE_LIBRARY_CREATE_INFO_KHR) continue;
+        const auto* libraries = reinterpret_cast<const VkPipelineLibraryCreateInfoKHR*>(s);
+        for (uint32_t l = 0; libraries->pLibraries && l < libraries->libraryCount; ++l) {
+          if (auto library = state.ray_bindings.Pipeline(libraries->pLibraries[l])) {
+            use.use.Merge(library->use);
+            use.partly_unknown |= library->partly_unknown;
+          }
         }
       }
       Keep(state, pipelines[i], std::move(use), info.flags);
@@ -161,8 +229,8 @@ void RecordBindPipelineForTraces(DeviceState& state, VkCommandBuffer cb, VkPipel
                                  VkPipeline pipeline) {
   const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
   if (point == BoundStructures::kPointCount) return;
-  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
-    recording->bound_structures.BindPipeline(point, state.ray_bindings.Pipeline(pipeline));
+  if (CommandBufferState* recording = Following(state, cb)) {
+    recording->bound_structures.BindPipeline(point, PipelineUse(state, pipeline));
   }
 }
 
@@ -170,7 +238,7 @@ void RecordBindDescriptorSets(DeviceState& state, VkCommandBuffer cb, VkPipeline
                               uint32_t first_set, uint32_t count, const VkDescriptorSet* sets) {
   const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
   if (point == BoundStructures::kPointCount) return;
-  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
+  if (CommandBufferState* recording = Following(state, cb)) {
     Guarded(state, [&] { recording->bound_structures.BindSets(point, first_set, count, sets); });
   }
 }
@@ -179,7 +247,7 @@ void RecordPushDescriptorSet(DeviceState& state, VkCommandBuffer cb, VkPipelineB
                              uint32_t write_count, const VkWriteDescriptorSet* writes) {
   const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
   if (point == BoundStructures::kPointCount) return;
-  std::shared_ptr<CommandBufferState> recording = Following(state, cb);
+  CommandBufferState* recording = Following(state, cb);
   if (!recording) return;
   BoundStructures& bound = recording->bound_structures;
   Guarded(state, [&] {
@@ -198,27 +266,27 @@ void RecordPushDescriptorSet(DeviceState& state, VkCommandBuffer cb, VkPipelineB
 }
 
 void RecordPushDescriptorSetWithTemplate(DeviceState& state, VkCommandBuffer cb, uint32_t set) {
-  if (std::shared_ptr<CommandBufferState> recording = Following(state, cb)) {
+  if (CommandBufferState* recording = Following(state, cb)) {
     Guarded(state, [&] {
-      recording->bound_structures.PushUnknown(BoundStructures::kCompute, set);
-      recording->bound_structures.PushUnknown(BoundStructures::kRayTracing, set);
+      for (uint8_t point = 0; point < BoundStructures::kPointCount; ++point) {
+        recording->bound_structures.PushUnknown(static_cast<BoundStructures::Point>(point), set);
+      }
     });
   }
 }
 
 void RecordExecuteForTraces(DeviceState& state, VkCommandBuffer primary) {
-  if (std::shared_ptr<CommandBufferState> recording = Following(state, primary)) {
+  if (CommandBufferState* recording = Following(state, primary)) {
     recording->bound_structures.Forget();
   }
 }
 
 void RecordTraceCommand(DeviceState& state, VkCommandBuffer cb, OpCommand command) {
-  std::shared_ptr<CommandBufferState> recording = Following(state, cb);
+  CommandBufferState* recording = Following(state, cb);
   if (!recording) return;
-  const bool traces = command == OpCommand::kCmdTraceRays || command == OpCommand::kCmdTraceRaysIndirect ||
-                      command == OpCommand::kCmdTraceRaysIndirect2;
-  const BoundStructures::Point point = traces ? BoundStructures::kRayTracing : BoundStructures::kCompute;
-  if (!recording->bound_structures.pipeline(point)) return;
+  const BoundStructures::Point point = PointOfCommand(command);
+  if (!recording->bound_structures.pipeline(point)) return;  // most draws: their pipeline reads no structure
+  const bool traces = point == BoundStructures::kRayTracing;
   thread_local std::vector<TracedBinding> traced;
   traced.clear();
   try {

@@ -16,6 +16,8 @@ void RecordCreateComputePipelines(DeviceState& state, uint32_t count, const VkCo
                                   const VkPipeline* pipelines);
 void RecordCreateRayTracingPipelines(DeviceState& state, uint32_t count, const VkRayTracingPipelineCreateInfoKHR* infos,
                                      const VkPipeline* pipelines);
+void RecordCreateGraphicsPipelines(DeviceState& state, uint32_t count, const VkGraphicsPipelineCreateInfo* infos,
+                                   const VkPipeline* pipelines);
 void RecordDestroyPipeline(DeviceState& state, VkPipeline pipeline);
 void RecordCreateDescriptorSetLayout(DeviceState& state, const VkDescriptorSetLayoutCreateInfo& info,
                                      VkDescriptorSetLayout layout);

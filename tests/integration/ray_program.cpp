@@ -4,6 +4,8 @@
 #include <cstring>
 #include <vector>
 
+#include "draw_ray.frag.h"
+#include "draw_ray.vert.h"
 #include "ray_query.comp.h"
 #include "trace_miss.rmiss.h"
 #include "trace_ray.rgen.h"
@@ -38,6 +40,15 @@ vkkit::DeviceOptions RayDevice() {
   return options;
 }
 
+vkkit::DeviceOptions RayDrawDevice() {
+  static VkPhysicalDeviceFeatures2 core{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  core.features.fragmentStoresAndAtomics = VK_TRUE;
+  vkkit::DeviceOptions options = RayDevice();
+  core.pNext = options.features;
+  options.features = &core;
+  return options;
+}
+
 struct RayProgram::Writes {
   Writes(const RayProgram& p, VkAccelerationStructureKHR structure) : as(structure) {
     as_info.accelerationStructureCount = 1;
@@ -59,8 +70,9 @@ struct RayProgram::Writes {
 
 RayProgram::RayProgram(vkkit::Device& device, Kind kind, bool push) : device_(device), kind_(kind) {
   const VkDevice d = device.handle();
-  const VkShaderStageFlags stage =
-      kind == Kind::kRayQuery ? VK_SHADER_STAGE_COMPUTE_BIT : VK_SHADER_STAGE_RAYGEN_BIT_KHR;
+  const VkShaderStageFlags stage = kind == Kind::kRayQuery ? VK_SHADER_STAGE_COMPUTE_BIT
+                                   : kind == Kind::kDraw   ? VK_SHADER_STAGE_FRAGMENT_BIT
+                                                           : VK_SHADER_STAGE_RAYGEN_BIT_KHR;
   const VkDescriptorSetLayoutBinding bindings[2] = {
       {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, stage, nullptr},
       {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr}};
@@ -76,6 +88,8 @@ RayProgram::RayProgram(vkkit::Device& device, Kind kind, bool push) : device_(de
   output_ = device.CreateBuffer(256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (kind == Kind::kRayQuery) {
     MakeComputePipeline();
+  } else if (kind == Kind::kDraw) {
+    MakeGraphicsPipeline();
   } else {
     MakeRayTracingPipeline();
   }
@@ -102,6 +116,8 @@ RayProgram::~RayProgram() {
   vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
   device_.Destroy(output_);
   if (sbt_.buffer) device_.Destroy(sbt_);
+  if (framebuffer_) vkDestroyFramebuffer(d, framebuffer_, nullptr);
+  if (render_pass_) vkDestroyRenderPass(d, render_pass_, nullptr);
 }
 
 void RayProgram::Write(VkAccelerationStructureKHR structure) {
@@ -143,6 +159,16 @@ void RayProgram::Record(VkCommandBuffer cb, VkAccelerationStructureKHR pushed) {
     vkCmdDispatch(cb, 1, 1, 1);
     return;
   }
+  if (kind_ == Kind::kDraw) {
+    VkRenderPassBeginInfo begin{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    begin.renderPass = render_pass_;
+    begin.framebuffer = framebuffer_;
+    begin.renderArea.extent = {1, 1};
+    vkCmdBeginRenderPass(cb, &begin, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdDraw(cb, 3, 1, 0, 0);
+    vkCmdEndRenderPass(cb);
+    return;
+  }
   const VkStridedDeviceAddressRegionKHR none{};
   Proc<PFN_vkCmdTraceRaysKHR>(device_, "vkCmdTraceRaysKHR")(cb, &raygen_, &miss_, &none, &none, 1, 1, 1);
 }
@@ -151,8 +177,9 @@ void RayProgram::BarrierAfterBuild(VkCommandBuffer cb) const {
   VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
   barrier.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR;
-  const VkPipelineStageFlags stage =
-      kind_ == Kind::kRayQuery ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
+  const VkPipelineStageFlags stage = kind_ == Kind::kRayQuery ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT
+                                     : kind_ == Kind::kDraw   ? VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT
+                                                              : VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR;
   vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, stage, 0, 1, &barrier, 0, nullptr, 0,
                        nullptr);
 }
@@ -168,6 +195,62 @@ void RayProgram::MakeComputePipeline() {
   vkkit::Check(vkCreateComputePipelines(device_.handle(), VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_),
                "vkCreateComputePipelines");
   vkDestroyShaderModule(device_.handle(), module, nullptr);  // the pipeline keeps what it needs
+}
+
+void RayProgram::MakeGraphicsPipeline() {
+  const VkDevice d = device_.handle();
+  // A render pass and a 1x1 framebuffer without attachments: the fragment shader's one invocation writes the buffer.
+  VkSubpassDescription subpass{};
+  subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  VkRenderPassCreateInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+  pass.subpassCount = 1;
+  pass.pSubpasses = &subpass;
+  vkkit::Check(vkCreateRenderPass(d, &pass, nullptr, &render_pass_), "vkCreateRenderPass");
+  VkFramebufferCreateInfo framebuffer{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+  framebuffer.renderPass = render_pass_;
+  framebuffer.width = framebuffer.height = framebuffer.layers = 1;
+  vkkit::Check(vkCreateFramebuffer(d, &framebuffer, nullptr, &framebuffer_), "vkCreateFramebuffer");
+
+  const VkShaderModule vert = MakeModule(d, kDrawRayVert, sizeof(kDrawRayVert));
+  const VkShaderModule frag = MakeModule(d, kDrawRayFrag, sizeof(kDrawRayFrag));
+  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  stages[0].module = vert;
+  stages[0].pName = "main";
+  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  stages[1].module = frag;
+  stages[1].pName = "main";
+  VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  const VkViewport viewport{0, 0, 1, 1, 0, 1};
+  const VkRect2D scissor{{0, 0}, {1, 1}};
+  VkPipelineViewportStateCreateInfo viewports{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  viewports.viewportCount = 1;
+  viewports.pViewports = &viewport;
+  viewports.scissorCount = 1;
+  viewports.pScissors = &scissor;
+  VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  raster.polygonMode = VK_POLYGON_MODE_FILL;
+  raster.cullMode = VK_CULL_MODE_NONE;
+  raster.lineWidth = 1;
+  VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  info.stageCount = 2;
+  info.pStages = stages;
+  info.pVertexInputState = &vertex_input;
+  info.pInputAssemblyState = &assembly;
+  info.pViewportState = &viewports;
+  info.pRasterizationState = &raster;
+  info.pMultisampleState = &multisample;
+  info.layout = layout_;
+  info.renderPass = render_pass_;
+  vkkit::Check(vkCreateGraphicsPipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_),
+               "vkCreateGraphicsPipelines");
+  vkDestroyShaderModule(d, vert, nullptr);
+  vkDestroyShaderModule(d, frag, nullptr);
 }
 
 void RayProgram::MakeRayTracingPipeline() {

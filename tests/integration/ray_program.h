@@ -12,11 +12,16 @@ namespace asval_test {
 // lavapipe).
 vkkit::DeviceOptions RayDevice();
 
-// A compute pipeline with a ray query (ray_query.comp) or a ray-tracing pipeline (trace_ray.rgen and
-// trace_miss.rmiss, with its shader binding table). `push`: the set layout is for push descriptors (no set).
+// The same with fragmentStoresAndAtomics, for RayProgram::Kind::kDraw.
+vkkit::DeviceOptions RayDrawDevice();
+
+// A compute pipeline with a ray query (ray_query.comp), a ray-tracing pipeline (trace_ray.rgen and
+// trace_miss.rmiss, with its shader binding table), or a graphics pipeline whose fragment shader queries the ray
+// (draw_ray.vert, draw_ray.frag: one draw into a 1x1 framebuffer without attachments; needs RayDrawDevice()).
+// `push`: the set layout is for push descriptors (no set).
 class RayProgram {
  public:
-  enum class Kind { kRayQuery, kTraceRays };
+  enum class Kind { kRayQuery, kTraceRays, kDraw };
   RayProgram(vkkit::Device& device, Kind kind, bool push = false);
   ~RayProgram();
   RayProgram(const RayProgram&) = delete;
@@ -38,10 +43,12 @@ class RayProgram {
  private:
   struct Writes;
   VkPipelineBindPoint bind_point() const {
+    if (kind_ == Kind::kDraw) return VK_PIPELINE_BIND_POINT_GRAPHICS;
     return kind_ == Kind::kRayQuery ? VK_PIPELINE_BIND_POINT_COMPUTE : VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR;
   }
   void MakeComputePipeline();
   void MakeRayTracingPipeline();
+  void MakeGraphicsPipeline();
 
   vkkit::Device& device_;
   Kind kind_;
@@ -52,6 +59,8 @@ class RayProgram {
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   vkkit::Buffer output_;
   vkkit::Buffer sbt_;
+  VkRenderPass render_pass_ = VK_NULL_HANDLE;  // kDraw: no attachments
+  VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
   VkStridedDeviceAddressRegionKHR raygen_{}, miss_{};
 };
 

@@ -70,6 +70,46 @@ TEST_CASE(
   CHECK(f.monitor().Verify() == "");
 }
 
+TEST_CASE("traces: a draw whose fragment shader queries a top-level structure no build executed on (06352)",
+          "[integration][traces]") {
+  HistoryFixture f("traces", {}, RayDrawDevice());
+  vkkit::Device& device = f.device();
+  Tlas never_built(device);
+  Commands commands(device);
+  RayProgram program(device, RayProgram::Kind::kDraw);
+  program.Write(never_built.handle());
+  f.monitor().Expect(kRayQueryBuilt);
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));  // skipped (VK_TRUE)
+  CHECK(f.monitor().Verify() == "");
+  RayProgram pushing(device, RayProgram::Kind::kDraw, true);
+  f.monitor().Expect(kRayQueryBuilt);
+  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { pushing.Record(c, never_built.handle()); }));
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("traces valid twin: a draw queries a structure built before it, in its command buffer or an earlier one",
+          "[integration][traces]") {
+  HistoryFixture f(nullptr, {}, RayDrawDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  RayProgram program(device, RayProgram::Kind::kDraw);
+  program.Write(scene.tlas.handle());
+  program.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+    scene.Build(commands, c);
+    program.BarrierAfterBuild(c);
+    program.Record(c);
+  })) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  RayProgram pushing(device, RayProgram::Kind::kDraw, true);
+  pushing.Clear();
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { pushing.Record(c, scene.tlas.handle()); })) ==
+          VK_SUCCESS);
+  CHECK(pushing.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
 TEST_CASE("traces valid twin: the trace reads a structure built earlier in execution order", "[integration][traces]") {
   HistoryFixture f(nullptr, {}, RayDevice());
   vkkit::Device& device = f.device();
