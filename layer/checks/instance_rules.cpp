@@ -233,8 +233,11 @@ bool CheckInstanceReferences(const CheckContext& ctx, const InstanceReferenceChe
   // only where one can have something to say: a frame whose structures are all bound, built in commands of their
   // own, walks the instances once, for 06707.
   const bool per_structure = !live.all_bound || info.destination_count != 0 || !c.activities.empty();
-  // Per live structure: the first instance that references it (structure -1: none).
-  std::vector<Referenced> first;
+  // Per live structure: the first instance that references it (structure -1: none). The thread's own array, kept
+  // from one build to the next: a top level rebuilt every frame allocates nothing here (the capture's completions
+  // run one at a time per thread; nothing below calls back into this function).
+  thread_local std::vector<Referenced> first;
+  first.clear();
   if (per_structure || referenced) first.assign(live.structures.size(), Referenced{-1, 0, 0});
   const bool collect = per_structure || referenced;
   for (uint32_t j = 0; j < info.geometry_count; ++j) {
