@@ -848,5 +848,55 @@ TEST_CASE("history bench: command buffer without AS operations", "[.history-benc
   RunHistoryBench(BenchScenario{"command buffer without AS operations", 0, true, 100000});
 }
 
+
+// Family traces: a top level's trace walks the bottom levels its last build referenced only when one of the store's
+// stamps moved; bottom_layout_changes moves when a bottom level's contents are replaced by another geometry layout.
+std::shared_ptr<const BuildSnapshot> Snapshot(VkAccelerationStructureTypeKHR type,
+                                              std::initializer_list<VkGeometryTypeKHR> geometries) {
+  auto snapshot = std::make_shared<BuildSnapshot>();
+  snapshot->type = type;
+  for (VkGeometryTypeKHR g : geometries) {
+    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    geometry.geometryType = g;
+    snapshot->geometries.emplace_back(geometry, 1, true);
+  }
+  return snapshot;
+}
+
+TEST_CASE("history unit: bottom-level layout changes are counted, other rewrites are not", "[history][traces]") {
+  constexpr auto kBottom = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  const auto one = Snapshot(kBottom, {VK_GEOMETRY_TYPE_TRIANGLES_KHR});
+  const auto one_again = Snapshot(kBottom, {VK_GEOMETRY_TYPE_TRIANGLES_KHR});
+  const auto two = Snapshot(kBottom, {VK_GEOMETRY_TYPE_TRIANGLES_KHR, VK_GEOMETRY_TYPE_TRIANGLES_KHR});
+  const auto boxes = Snapshot(kBottom, {VK_GEOMETRY_TYPE_AABBS_KHR});
+  const auto top_one = Snapshot(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, {VK_GEOMETRY_TYPE_INSTANCES_KHR});
+  CHECK(SameGeometryLayout(*one, *one_again));
+  CHECK_FALSE(SameGeometryLayout(*one, *two));
+  CHECK_FALSE(SameGeometryLayout(*one, *boxes));
+
+  HistoryStore store;
+  const std::unique_lock<std::mutex> lock = store.Lock();
+  const VkAccelerationStructureKHR blas = Fake<VkAccelerationStructureKHR>(40);
+  AsHistory built;
+  built.kind = HistoryKind::kBuilt;
+  built.build = one;
+  const uint32_t record = store.Set(blas, built, nullptr);  // its first build: nothing replaced
+  CHECK(store.bottom_layout_changes() == 0);
+  store.Rewrite(record, blas, nullptr, one);  // rebuilt or refitted with the same parameters: one compare
+  store.Rewrite(record, blas, nullptr, one_again);  // other parameters, the same layout
+  CHECK(store.bottom_layout_changes() == 0);
+  store.Rewrite(record, blas, nullptr, two);
+  CHECK(store.bottom_layout_changes() == 1);
+  built.build = boxes;
+  store.SetAt(record, blas, built, nullptr);  // a copy or deserialization of another layout over it
+  CHECK(store.bottom_layout_changes() == 2);
+  // A top level's layout is not what its traces' bottom levels are judged by.
+  const VkAccelerationStructureKHR tlas = Fake<VkAccelerationStructureKHR>(41);
+  built.build = top_one;
+  const uint32_t top = store.Set(tlas, built, nullptr);
+  store.Rewrite(top, tlas, nullptr, Snapshot(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, {}));
+  CHECK(store.bottom_layout_changes() == 2);
+}
+
 }  // namespace
 }  // namespace asval
