@@ -1,7 +1,10 @@
 // Family traces (issue 29): ray-query work over top-level structures, as engines record it (the structure rebuilt
 // every frame and queried after a barrier in the same command buffer; built once in its own submission and queried
-// by later ones), and the fault: a dispatch whose descriptor names a top-level structure no build executed on.
+// by later ones; bottom levels streamed in and out, or rebuilt with another layout, under a TLAS rebuilt after
+// them), and the faults: a dispatch whose descriptor names a top-level structure no build executed on, and a top
+// level traced after a bottom level it references was destroyed.
 #include <cstring>
+#include <memory>
 
 #include "corpus.h"
 #include "ray_program.h"
@@ -53,6 +56,56 @@ CORPUS_CASE(TracesBuiltOnceQueriedLater, "traces-ray-query-in-later-submissions"
                "vkQueueSubmit");
   for (int frame = 0; frame < 3; ++frame) {
     VkCommandBuffer cb = commands.Begin();
+    program.Record(cb);
+    commands.End(cb);
+    vkkit::Check(commands.Submit(cb), "vkQueueSubmit");
+  }
+}
+
+CORPUS_CASE(TracesBottomLevelsStreamed, "traces-bottom-levels-streamed-under-tlas-rebuilt-each-frame", "patterns",
+            "bottom levels streamed in and out: each frame builds a new bottom level, rebuilds the TLAS over it, and "
+            "queries; after the frame's fence wait the previous frame's bottom level is destroyed (with its memory)",
+            {}) {
+  RayScene scene(device);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Commands commands(device);
+  std::unique_ptr<asval_test::Blas> previous;
+  for (int frame = 0; frame < 4; ++frame) {
+    auto streamed = std::make_unique<asval_test::Blas>(device, scene.inputs);
+    vkkit::Buffer instances = scene.tlas.MakeInstances({streamed.get()});
+    VkCommandBuffer cb = commands.Begin();
+    streamed->Build(cb, asval_test::Shape{});
+    commands.Barrier(cb);
+    scene.tlas.Record(cb, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    program.BarrierAfterBuild(cb);
+    program.Record(cb);
+    commands.End(cb);
+    vkkit::Check(commands.Submit(cb), "vkQueueSubmit");  // waits for the queue
+    device.Destroy(instances);
+    previous = std::move(streamed);  // the one before is destroyed here: the TLAS no longer references it
+  }
+}
+
+CORPUS_CASE(TracesBottomLevelRelaidOut, "traces-bottom-level-rebuilt-with-more-geometries-then-tlas", "patterns",
+            "a bottom level rebuilt with a second geometry (an object gaining a part), the TLAS rebuilt after it in "
+            "the same command buffer, then queried in later frames",
+            {}) {
+  RayScene scene(device);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Commands commands(device);
+  asval_test::Shape two;
+  two.geometries = 2;
+  for (int frame = 0; frame < 3; ++frame) {
+    VkCommandBuffer cb = commands.Begin();
+    if (frame == 0) scene.Build(commands, cb);
+    if (frame == 1) {
+      scene.blas.Build(cb, two);
+      commands.Barrier(cb);
+      scene.tlas.Record(cb, scene.instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    }
+    program.BarrierAfterBuild(cb);
     program.Record(cb);
     commands.End(cb);
     vkkit::Check(commands.Submit(cb), "vkQueueSubmit");
