@@ -207,61 +207,78 @@ TEST_CASE("traces: descriptors written through an update template are followed",
   CHECK(f.monitor().Verify() == "");
 }
 
+// The bottom levels under a traced top level: a scene built and waited for (the capture has read the top level's
+// instances by the time the wait returned), and a ray-query program whose set names the top level.
+struct TracedScene {
+  explicit TracedScene(vkkit::Device& d) : device(d), commands(d), scene(d), program(d, RayProgram::Kind::kRayQuery) {
+    REQUIRE(Run([&](VkCommandBuffer c) { scene.Build(commands, c); }) == VK_SUCCESS);
+    program.Write(scene.tlas.handle());
+  }
+  // Records one command buffer and submits it (waited for).
+  VkResult Run(const std::function<void(VkCommandBuffer)>& record) {
+    return commands.Submit(Recorded(commands, record));
+  }
+  // `before`, the barrier, and the query (its output cleared first); a valid twin's query must hit.
+  void QueryAfter(const std::function<void(VkCommandBuffer)>& before) {
+    program.Clear();
+    REQUIRE(Run([&](VkCommandBuffer c) {
+              before(c);
+              program.BarrierAfterBuild(c);
+              program.Record(c);
+            }) == VK_SUCCESS);
+    CHECK(program.hit() == 1u);
+  }
+  // The query alone, expected to be reported (the monitor's VK_TRUE skips it: lavapipe never runs it).
+  void QueryReported(Monitor& monitor, const char* id) {
+    monitor.Expect(id);
+    Run([&](VkCommandBuffer c) { program.Record(c); });
+    CHECK(monitor.Verify() == "");
+  }
+  // Streaming out: `replacement` takes the old bottom level's place in a rebuild of the top level, waited for.
+  void RebuildWith(Blas& replacement) {
+    vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
+    REQUIRE(Run([&](VkCommandBuffer c) {
+              replacement.Build(c, Shape{});
+              commands.Barrier(c);
+              scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+            }) == VK_SUCCESS);
+    device.Destroy(instances);
+  }
+
+  vkkit::Device& device;
+  Commands commands;
+  RayScene scene;
+  RayProgram program;
+};
+
 TEST_CASE(
     "traces: a traced top level whose last build referenced a bottom level destroyed since is reported "
     "(ASVAL-Traces-BottomLevelInvalid)",
     "[integration][traces]") {
   HistoryFixture f("traces", {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  // Built and waited for: the capture has read the top level's instances by the time the wait returned.
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
-  scene.blas.DestroyHandle();  // its storage stays: a driver that ran the query would still find its bytes
-  f.monitor().Expect("ASVAL-Traces-BottomLevelInvalid");
-  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));
-  CHECK(f.monitor().Verify() == "");
+  TracedScene t(f.device());
+  t.scene.blas.DestroyHandle();  // its storage stays: a driver that ran the query would still find its bytes
+  t.QueryReported(f.monitor(), "ASVAL-Traces-BottomLevelInvalid");
 }
 
 TEST_CASE("traces valid twin: a bottom level destroyed once the traced top level was rebuilt without it stays silent",
           "[integration][traces]") {
   HistoryFixture f(nullptr, {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
-  // Streaming out: a new bottom level takes the old one's place in the top level, rebuilt and waited for; then the
-  // old one is destroyed and the top level traced.
-  Blas replacement(device, scene.inputs);
-  vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-    replacement.Build(c, Shape{});
-    commands.Barrier(c);
-    scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-  })) == VK_SUCCESS);
-  scene.blas.DestroyHandle();
-  program.Clear();
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); })) == VK_SUCCESS);
-  CHECK(program.hit() == 1u);
+  TracedScene t(f.device());
+  Blas replacement(t.device, t.scene.inputs);
+  t.RebuildWith(replacement);
+  t.scene.blas.DestroyHandle();
+  t.QueryAfter([](VkCommandBuffer) {});
   // Rebuilt in the same command buffer as the query, after another bottom level went: what that build referenced is
   // not known before it completes (its references were judged there: pInfos-06707), so nothing is said.
-  Blas third(device, scene.inputs);
-  vkkit::Buffer third_instances = scene.tlas.MakeInstances({&third});
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { third.Build(c, Shape{}); })) == VK_SUCCESS);
+  Blas third(t.device, t.scene.inputs);
+  vkkit::Buffer third_instances = t.scene.tlas.MakeInstances({&third});
+  REQUIRE(t.Run([&](VkCommandBuffer c) { third.Build(c, Shape{}); }) == VK_SUCCESS);
   replacement.DestroyHandle();  // the top level still references it, until the rebuild below runs
-  program.Clear();
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-    scene.tlas.Record(c, third_instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-    program.BarrierAfterBuild(c);
-    program.Record(c);
-  })) == VK_SUCCESS);
-  CHECK(program.hit() == 1u);
-  device.Destroy(instances);
-  device.Destroy(third_instances);
+  t.QueryAfter([&](VkCommandBuffer c) {
+    t.scene.tlas.Record(c, third_instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  });
+  t.device.Destroy(third_instances);
   CHECK(f.monitor().Verify() == "");
 }
 
@@ -270,45 +287,25 @@ TEST_CASE(
     "(ASVAL-Traces-BottomLevelInvalid)",
     "[integration][traces]") {
   HistoryFixture f("traces", {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
-  scene.blas.FreeStorageMemory();  // the structure and its buffer stay alive
-  f.monitor().Expect("ASVAL-Traces-BottomLevelInvalid");
-  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));  // skipped (VK_TRUE)
-  CHECK(f.monitor().Verify() == "");
+  TracedScene t(f.device());
+  t.scene.blas.FreeStorageMemory();  // the structure and its buffer stay alive
+  t.QueryReported(f.monitor(), "ASVAL-Traces-BottomLevelInvalid");
 }
 
 TEST_CASE("traces valid twin: a bottom level's memory freed once the traced top level was rebuilt without it",
           "[integration][traces]") {
   HistoryFixture f(nullptr, {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
-  Blas replacement(device, scene.inputs);
-  vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-    replacement.Build(c, Shape{});
-    commands.Barrier(c);
-    scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-  })) == VK_SUCCESS);
-  scene.blas.FreeStorageMemory();  // alive, unreferenced: its memory may go
-  program.Clear();
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); })) == VK_SUCCESS);
-  CHECK(program.hit() == 1u);
-  device.Destroy(instances);
+  TracedScene t(f.device());
+  Blas replacement(t.device, t.scene.inputs);
+  t.RebuildWith(replacement);
+  t.scene.blas.FreeStorageMemory();  // alive, unreferenced: its memory may go
+  t.QueryAfter([](VkCommandBuffer) {});
   CHECK(f.monitor().Verify() == "");
 }
 
-Shape TwoGeometries() {
+Shape Geometries(uint32_t count) {
   Shape shape;
-  shape.geometries = 2;
+  shape.geometries = count;
   return shape;
 }
 
@@ -317,27 +314,17 @@ TEST_CASE(
     "(ASVAL-Traces-BottomLevelChanged)",
     "[integration][traces]") {
   HistoryFixture f("traces", {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
+  TracedScene t(f.device());
   // The bottom level rebuilt with two geometries; the top level, built over its one geometry, is not rebuilt.
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.blas.Build(c, TwoGeometries()); })) ==
-          VK_SUCCESS);
-  f.monitor().Expect("ASVAL-Traces-BottomLevelChanged");
-  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); }));
-  CHECK(f.monitor().Verify() == "");
+  REQUIRE(t.Run([&](VkCommandBuffer c) { t.scene.blas.Build(c, Geometries(2)); }) == VK_SUCCESS);
+  t.QueryReported(f.monitor(), "ASVAL-Traces-BottomLevelChanged");
   // A rebuild with three geometries in the command buffer of the query, before it: warned in execution order.
-  Shape three;
-  three.geometries = 3;
   f.monitor().Expect("ASVAL-Traces-BottomLevelChanged");
-  commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-    scene.blas.Build(c, three);
-    commands.Barrier(c);
-    program.Record(c);
-  }));
+  t.Run([&](VkCommandBuffer c) {
+    t.scene.blas.Build(c, Geometries(3));
+    t.commands.Barrier(c);
+    t.program.Record(c);
+  });
   CHECK(f.monitor().Verify() == "");
 }
 
@@ -346,35 +333,22 @@ TEST_CASE(
     "silent",
     "[integration][traces]") {
   HistoryFixture f(nullptr, {}, RayDevice());
-  vkkit::Device& device = f.device();
-  Commands commands(device);
-  RayScene scene(device);
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
-  RayProgram program(device, RayProgram::Kind::kRayQuery);
-  program.Write(scene.tlas.handle());
-  const auto query = [&](const std::function<void(VkCommandBuffer)>& before) {
-    program.Clear();
-    REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-      before(c);
-      program.BarrierAfterBuild(c);
-      program.Record(c);
-    })) == VK_SUCCESS);
-    CHECK(program.hit() == 1u);
-  };
+  TracedScene t(f.device());
+  RayScene& scene = t.scene;
   // Refitted (an update keeps the geometries), then rebuilt with the same layout, without the top level.
-  query([&](VkCommandBuffer c) { scene.blas.Update(c, Shape{}); });
-  query([&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); });
+  t.QueryAfter([&](VkCommandBuffer c) { scene.blas.Update(c, Shape{}); });
+  t.QueryAfter([&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); });
   // Rebuilt with two geometries and the top level rebuilt after it, in one submission and in two.
-  query([&](VkCommandBuffer c) {
-    scene.blas.Build(c, TwoGeometries());
-    commands.Barrier(c);
+  t.QueryAfter([&](VkCommandBuffer c) {
+    scene.blas.Build(c, Geometries(2));
+    t.commands.Barrier(c);
     scene.tlas.Record(c, scene.instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
   });
-  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); })) == VK_SUCCESS);
-  query([&](VkCommandBuffer c) {
+  REQUIRE(t.Run([&](VkCommandBuffer c) { scene.blas.Build(c, Shape{}); }) == VK_SUCCESS);
+  t.QueryAfter([&](VkCommandBuffer c) {
     scene.tlas.Record(c, scene.instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
   });
-  query([](VkCommandBuffer) {});
+  t.QueryAfter([](VkCommandBuffer) {});
   CHECK(f.monitor().Verify() == "");
 }
 
