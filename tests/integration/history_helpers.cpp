@@ -339,6 +339,16 @@ void Tlas::DestroyHandle() {
   as_.handle = VK_NULL_HANDLE;
 }
 
+void Tlas::DestroyStorageBuffer() {
+  if (as_.storage.buffer) vkDestroyBuffer(device_.handle(), as_.storage.buffer, nullptr);
+  as_.storage.buffer = VK_NULL_HANDLE;  // ~Tlas frees the memory only
+}
+
+void Tlas::FreeStorageMemory() {
+  if (as_.storage.memory) vkFreeMemory(device_.handle(), as_.storage.memory, nullptr);
+  as_.storage.memory = VK_NULL_HANDLE;  // ~Tlas destroys the buffer only
+}
+
 VkAccelerationStructureInstanceKHR InstanceRecord(VkDeviceAddress reference, uint32_t i) {
   VkAccelerationStructureInstanceKHR instance{};
   instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;

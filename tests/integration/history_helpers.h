@@ -200,6 +200,10 @@ class Tlas {
   VkAccelerationStructureKHR handle() const { return as_.handle; }
   // Destroys the structure, not its storage (lifetime tests).
   void DestroyHandle();
+  // Destroys the VkBuffer of its storage, not the structure nor the memory; or frees the memory, not the buffer
+  // (lifetime tests: what a pending trace of it reads).
+  void DestroyStorageBuffer();
+  void FreeStorageMemory();
 
  private:
   vkkit::Device& device_;

@@ -401,5 +401,57 @@ TEST_CASE("lifetime valid twin: a top-level structure destroyed after the ray qu
   CHECK(f.monitor().Verify() == "");
 }
 
+// The top level's storage, which the pending query reads through it: its buffer destroyed, or its memory freed.
+// Reported, and kept back by the layer until the query completed (the monitor's VK_TRUE), so lavapipe never reads
+// freed memory; the twins do the same once the query completed.
+void StorageGoesWhileQueryPending(bool pending, const std::function<void(Tlas&)>& goes, const char* vuid) {
+  HistoryFixture f(pending ? "lifetime" : nullptr, {}, RayTimelineDevice());
+  vkkit::Device& device = f.device();
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  Timeline gate(device);
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
+  if (pending) {
+    REQUIRE(SubmitOn(device.queue(), cb, gate, 1, 2) == VK_SUCCESS);  // runs once the host signals 1
+    f.monitor().Expect(vuid);
+    goes(scene.tlas);
+    CHECK(f.monitor().Verify() == "");
+    CHECK(gate.HostSignal(1) == VK_SUCCESS);
+    CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  } else {
+    REQUIRE(SubmitOn(device.queue(), cb, gate, 0, 1) == VK_SUCCESS);
+    REQUIRE(gate.HostWait(1, 10ull * 1000 * 1000 * 1000) == VK_SUCCESS);  // completed, learned on the host
+    goes(scene.tlas);
+  }
+  CHECK(program.hit() == 1u);
+  scene.tlas.DestroyHandle();  // before its memory goes, where the test kept the memory
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "lifetime: the storage buffer of a top-level structure a pending ray query reads, destroyed, is reported "
+    "(buffer-00922)",
+    "[integration][lifetime][traces]") {
+  StorageGoesWhileQueryPending(
+      true, [](Tlas& tlas) { tlas.DestroyStorageBuffer(); }, "VUID-vkDestroyBuffer-buffer-00922");
+}
+
+TEST_CASE("lifetime: the memory of a top-level structure a pending ray query reads, freed, is reported (memory-00677)",
+          "[integration][lifetime][traces]") {
+  StorageGoesWhileQueryPending(
+      true, [](Tlas& tlas) { tlas.FreeStorageMemory(); }, "VUID-vkFreeMemory-memory-00677");
+}
+
+TEST_CASE("lifetime valid twin: a traced top level's storage buffer destroyed, or memory freed, after the query",
+          "[integration][lifetime][traces]") {
+  StorageGoesWhileQueryPending(
+      false, [](Tlas& tlas) { tlas.DestroyStorageBuffer(); }, nullptr);
+  StorageGoesWhileQueryPending(
+      false, [](Tlas& tlas) { tlas.FreeStorageMemory(); }, nullptr);
+}
+
 }  // namespace
 }  // namespace asval_test
