@@ -38,6 +38,18 @@ void MergeStage(const DeviceState& state, const VkPipelineShaderStageCreateInfo&
   }
 }
 
+// Libraries linked into a pipeline are pipelines created through this layer: their uses were kept (none kept: they
+// read none).
+void MergeLibraries(const DeviceState& state, const VkPipelineLibraryCreateInfoKHR& libraries,
+                    PipelineStructureUse& use) {
+  for (uint32_t l = 0; libraries.pLibraries && l < libraries.libraryCount; ++l) {
+    if (auto library = state.ray_bindings.Pipeline(libraries.pLibraries[l])) {
+      use.use.Merge(library->use);
+      use.partly_unknown |= library->partly_unknown;
+    }
+  }
+}
+
 void Keep(DeviceState& state, VkPipeline pipeline, PipelineStructureUse use, VkPipelineCreateFlags flags) {
   if (pipeline == VK_NULL_HANDLE || !use.use.uses_structures()) return;
   use.descriptor_buffers = (flags & VK_PIPELINE_CREATE_DESCRIPTOR_BUFFER_BIT_EXT) != 0;
@@ -133,14 +145,7 @@ void RecordCreateRayTracingPipelines(DeviceState& state, uint32_t count, const V
       const VkRayTracingPipelineCreateInfoKHR& info = infos[i];
       PipelineStructureUse use;
       for (uint32_t s = 0; info.pStages && s < info.stageCount; ++s) MergeStage(state, info.pStages[s], use);
-      // Libraries are pipelines created through this layer: their uses were kept (none kept: they read none).
-      for (uint32_t l = 0; info.pLibraryInfo && info.pLibraryInfo->pLibraries && l < info.pLibraryInfo->libraryCount;
-           ++l) {
-        if (auto library = state.ray_bindings.Pipeline(info.pLibraryInfo->pLibraries[l])) {
-          use.use.Merge(library->use);
-          use.partly_unknown |= library->partly_unknown;
-        }
-      }
+      if (info.pLibraryInfo) MergeLibraries(state, *info.pLibraryInfo, use);
       Keep(state, pipelines[i], std::move(use), info.flags);
     }
   });
@@ -154,16 +159,10 @@ void RecordCreateGraphicsPipelines(DeviceState& state, uint32_t count, const VkG
       const VkGraphicsPipelineCreateInfo& info = infos[i];
       PipelineStructureUse use;
       for (uint32_t s = 0; info.pStages && s < info.stageCount; ++s) MergeStage(state, info.pStages[s], use);
-      // Graphics pipeline libraries (VK_EXT_graphics_pipeline_library) linked into it: pipelines created through
-      // this layer, their uses kept (none kept: they read none).
+      // Graphics pipeline libraries (VK_EXT_graphics_pipeline_library) linked into it, chained.
       for (auto* s = static_cast<const VkBaseInStructure*>(info.pNext); s; s = s->pNext) {
-        if (s->sType != VK_STRUCTURE_TYPE_PIPELINE_LIBRARY_CREATE_INFO_KHR) continue;
-        const auto* libraries = reinterpret_cast<const VkPipelineLibraryCreateInfoKHR*>(s);
-        for (uint32_t l = 0; libraries->pLibraries && l < libraries->libraryCount; ++l) {
-          if (auto library = state.ray_bindings.Pipeline(libraries->pLibraries[l])) {
-            use.use.Merge(library->use);
-            use.partly_unknown |= library->partly_unknown;
-          }
+        if (s->sType == VK_STRUCTURE_TYPE_PIPELINE_LIBRARY_CREATE_INFO_KHR) {
+          MergeLibraries(state, *reinterpret_cast<const VkPipelineLibraryCreateInfoKHR*>(s), use);
         }
       }
       Keep(state, pipelines[i], std::move(use), info.flags);

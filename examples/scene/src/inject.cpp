@@ -90,6 +90,28 @@ class Injector {
     RecordBuild(gpu_, cb, {input.Info(kBuild, VK_NULL_HANDLE, dst, scratch)}, {&input});
   }
 
+  // A spare bottom-level structure: the ground built again into a structure of the scratchpad, submitted and waited.
+  AccelerationStructure& SpareGround() {
+    const BuildInput& ground = s_.statics.input(StaticBlases::kGround);
+    const VkAccelerationStructureBuildSizesInfoKHR sizes = ground.QuerySizes(gpu_);
+    AccelerationStructure& spare =
+        pad_.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize, "spare");
+    const Buffer& scratch = pad_.NewScratch(sizes.buildScratchSize);
+    RecordAndSubmit([&](VkCommandBuffer cb) { BuildInto(cb, ground, spare.handle, scratch.address); });
+    return spare;
+  }
+
+  // The next frame's instances written, with the first active one after instance 0 made to reference `reference`:
+  // returns its index.
+  uint32_t ReferenceFromNextFrame(VkDeviceAddress reference) {
+    s_.top.WriteInstances(parity_, Scene::TimeOf(s_.frames_done()));
+    VkAccelerationStructureInstanceKHR* instances = s_.top.instances(parity_);
+    uint32_t victim = 1;
+    while (victim < s_.top.count() && instances[victim].accelerationStructureReference == 0) ++victim;
+    instances[victim].accelerationStructureReference = reference;
+    return victim;
+  }
+
   void UpdateWithoutSource();
   void BottomIntoTopObject();
   void VertexStride();
@@ -292,22 +314,10 @@ void Injector::UpdateIndices() {
 
 void Injector::DestroyedInstance() {
   // A spare structure, built validly, whose handle is then destroyed while its memory stays allocated.
-  const BuildInput& ground = s_.statics.input(StaticBlases::kGround);
-  const VkAccelerationStructureBuildSizesInfoKHR sizes = ground.QuerySizes(gpu_);
-  AccelerationStructure& spare =
-      pad_.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize, "spare");
-  const Buffer& scratch = pad_.NewScratch(sizes.buildScratchSize);
-  VkCommandBuffer build = Record([&](VkCommandBuffer cb) { BuildInto(cb, ground, spare.handle, scratch.address); });
-  Submit({build});
-  gpu_.FreeCommandBuffer(build);
+  AccelerationStructure& spare = SpareGround();
   const VkDeviceAddress stale = spare.address;
   gpu_.DestroyHandle(spare);
-
-  s_.top.WriteInstances(parity_, Scene::TimeOf(s_.frames_done()));
-  VkAccelerationStructureInstanceKHR* instances = s_.top.instances(parity_);
-  uint32_t victim = 1;
-  while (victim < s_.top.count() && instances[victim].accelerationStructureReference == 0) ++victim;
-  instances[victim].accelerationStructureReference = stale;
+  const uint32_t victim = ReferenceFromNextFrame(stale);
   std::printf("fault: instance %u references the destroyed structure (0x%llx)\n", victim,
               static_cast<unsigned long long>(stale));
   RecordAndSubmit([&](VkCommandBuffer cb) { s_.top.RecordBuild(cb, parity_, kBuild); });
@@ -393,18 +403,8 @@ void Injector::TracedBlasDestroyed() {
   // A spare bottom level (the ground, built again), referenced by one instance of a valid top-level rebuild that
   // completes; then the spare's handle is destroyed while its memory stays allocated, and the frame is traced: the
   // top level's instance still names the destroyed structure, whose bytes a driver that ran the trace would find.
-  const BuildInput& ground = s_.statics.input(StaticBlases::kGround);
-  const VkAccelerationStructureBuildSizesInfoKHR sizes = ground.QuerySizes(gpu_);
-  AccelerationStructure& spare =
-      pad_.NewStructure(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize, "spare");
-  const Buffer& scratch = pad_.NewScratch(sizes.buildScratchSize);
-  RecordAndSubmit([&](VkCommandBuffer cb) { BuildInto(cb, ground, spare.handle, scratch.address); });
-
-  s_.top.WriteInstances(parity_, Scene::TimeOf(s_.frames_done()));
-  VkAccelerationStructureInstanceKHR* instances = s_.top.instances(parity_);
-  uint32_t victim = 1;
-  while (victim < s_.top.count() && instances[victim].accelerationStructureReference == 0) ++victim;
-  instances[victim].accelerationStructureReference = spare.address;
+  AccelerationStructure& spare = SpareGround();
+  const uint32_t victim = ReferenceFromNextFrame(spare.address);
   RecordAndSubmit([&](VkCommandBuffer cb) { s_.top.RecordBuild(cb, parity_, kBuild); });  // valid, waited for
   gpu_.DestroyHandle(spare);
   std::printf("fault: tracing a top level whose instance %u references a bottom level destroyed since\n", victim);
