@@ -74,16 +74,24 @@ struct TracedJudge {
         found = true;
         continue;
       }
-      // A structure whose buffer was destroyed while its memory stays is not judged (engines relocate so).
-      if (StorageOfStructure(state, **now) == StructureStorage::kMemoryFreed) {
+      // A structure whose buffer was destroyed while its memory stays is not judged (engines relocate so); nor one
+      // on a buffer the layer does not know or cannot follow (sparse): counted.
+      const StructureStorage storage = StorageOfStructure(state, **now);
+      if (storage == StructureStorage::kMemoryFreed) {
         ReportReferenced(b, top, h, r.as, "is still alive, but the memory its buffer was bound to was freed since");
         found = true;
         continue;
       }
+      if (storage != StructureStorage::kBound) Skip(TracedSkip::kBottomLevelUnknown);
       const AsHistory* bottom = r.build ? store.Find(r.as) : nullptr;
+      // Its layout cannot be compared: no build known when the top level's completed, or its history unknown now.
+      if (!bottom || bottom->kind != HistoryKind::kBuilt || !bottom->build) {
+        Skip(TracedSkip::kBottomLevelUnknown);
+        continue;
+      }
       // A later write of it (generation: an undone submission restores an older one, never judged).
-      if (bottom && bottom->kind == HistoryKind::kBuilt && bottom->build && bottom->build != r.build &&
-          bottom->generation > r.generation && !SameGeometryLayout(*r.build, *bottom->build)) {
+      if (bottom->build != r.build && bottom->generation > r.generation &&
+          !SameGeometryLayout(*r.build, *bottom->build)) {
         ReportRebuilt(b, top, h, r, *bottom->build);
         found = true;
       }
@@ -159,6 +167,8 @@ const char* TracedSkipName(TracedSkip skip) {
       return "unknown_history";
     case TracedSkip::kReferencesUnknown:
       return "references_unknown";
+    case TracedSkip::kBottomLevelUnknown:
+      return "bottom_level_unknown";
     case TracedSkip::kCount:
       break;
   }

@@ -26,6 +26,7 @@ enum class TracedSkip : uint8_t {
   kDestroyed,          // destroyed since it was written (its descriptor is stale)
   kUnknownHistory,     // the structure's history is unknown
   kReferencesUnknown,  // what its last build's instances referenced is not known (not captured, or not completed yet)
+  kBottomLevelUnknown,  // a referenced bottom level whose storage or history cannot be judged (counted per walk)
   kCount
 };
 const char* TracedSkipName(TracedSkip skip);

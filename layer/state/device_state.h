@@ -117,7 +117,7 @@ class DeviceState {
   // Family traces: the structures judged at submission, and why others were not (TracedSkip order).
   struct TraceCounters {
     std::atomic<uint64_t> judged{0};
-    std::array<std::atomic<uint64_t>, 7> skipped{};
+    std::array<std::atomic<uint64_t>, 8> skipped{};
   };
   mutable TraceCounters trace_counters;
   // Shader modules, pipelines, layouts, templates and descriptor sets that hold acceleration structures.

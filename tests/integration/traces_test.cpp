@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "ray_program.h"
+#include "temp_report.h"
 
 namespace asval_test {
 namespace {
@@ -301,6 +302,25 @@ TEST_CASE("traces valid twin: a bottom level's memory freed once the traced top 
   t.scene.blas.FreeStorageMemory();  // alive, unreferenced: its memory may go
   t.QueryAfter([](VkCommandBuffer) {});
   CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("traces: a referenced bottom level whose storage buffer was destroyed is not judged, and is counted",
+          "[integration][traces]") {
+  asval_test_common::TempReport report;
+  HistoryFixture f(nullptr, {{"report_file", report.path.c_str()}}, RayDevice());
+  {
+    TracedScene t(f.device());
+    t.scene.blas.DestroyStorageBuffer();  // its memory stays: engines relocate structures so
+    t.QueryAfter([](VkCommandBuffer) {});
+    CHECK(f.monitor().Verify() == "");
+  }
+  f.Close();
+  bool counted = false;
+  for (const std::string& line : report.Lines()) {
+    counted |= line.find("ASVAL-Traces-Summary") != std::string::npos &&
+               line.find("bottom_level_unknown=1") != std::string::npos;
+  }
+  CHECK(counted);
 }
 
 Shape Geometries(uint32_t count) {
