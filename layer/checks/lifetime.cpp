@@ -263,18 +263,23 @@ bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDevice
 void ReportLifetimeSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {
   const DeviceState::LifetimeCounters& c = state.lifetime_counters;
   const uint64_t judged = c.calls_judged.load(std::memory_order_relaxed);
-  if (judged == 0) return;
+  const uint64_t recorded = c.recorded_judged.load(std::memory_order_relaxed);
   const NamedCount reasons[] = {{"no_fence", c.skipped_no_fence.load(std::memory_order_relaxed)},
-                                {"host_may_know", c.skipped_host_may_know.load(std::memory_order_relaxed)}};
+                                {"host_may_know", c.skipped_host_may_know.load(std::memory_order_relaxed)},
+                                {"recorded_forgotten", c.skipped_recorded_forgotten.load(std::memory_order_relaxed)}};
+  if (judged == 0 && recorded == 0 && reasons[2].count == 0) return;
   const std::string text = fmt::format(
       "Objects in use by the device (lifetime): {} destroys and frees were judged against the work in flight, {} of "
-      "them made by the layer once that work completed (the app's callback or protect mode skipped them); pending "
-      "batches not judged: no_fence={} (no fence to ask), host_may_know={} (the host may have known them complete "
-      "before their fence: it read an event or query results, or another queue waited for their binary semaphore).",
-      judged, c.kept_back.load(std::memory_order_relaxed), reasons[0].count, reasons[1].count);
-  const NamedCounts counts{"lifetime_skipped", reasons, 2};
+      "them made by the layer once that work completed (the app's callback or protect mode skipped them); {} recorded "
+      "objects were found destroyed before their command buffer's submission. Not judged: no_fence={} (pending "
+      "batches with no fence to ask), host_may_know={} (pending batches the host may have known complete before their "
+      "fence: it read an event or query results, or another queue waited for their binary semaphore), "
+      "recorded_forgotten={} (recorded objects destroyed longer ago than the layer remembers destroys).",
+      judged, c.kept_back.load(std::memory_order_relaxed), recorded, reasons[0].count, reasons[1].count,
+      reasons[2].count);
+  const NamedCounts counts{"lifetime_skipped", reasons, 3};
   const Location where("vkDestroyDevice");
-  if (reasons[0].count + reasons[1].count != 0) {
+  if (reasons[0].count + reasons[1].count + reasons[2].count != 0) {
     reporter.ReportUnchecked(kLifetimeSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);
   } else {
     reporter.Report(Severity::kInfo, kLifetimeSummaryId, where, {Obj(VK_OBJECT_TYPE_DEVICE, device)}, text, counts);

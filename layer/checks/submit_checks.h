@@ -14,12 +14,14 @@ namespace asval {
 class SubmitChecks {
  public:
   // submission: the HistorySubmission's id (SubmissionCaptures::id), which the operations are judged within.
-  SubmitChecks(const CheckContext& ctx, uint64_t submission = 0) : ctx_(ctx), submission_(submission) {}
+  // submitted_at: the id when the app submitted them (0: `submission`; a deferred batch's is older).
+  SubmitChecks(const CheckContext& ctx, uint64_t submission = 0, uint64_t submitted_at = 0)
+      : ctx_(ctx), submission_(submission), submitted_at_(submitted_at ? submitted_at : submission) {}
 
   // The check for the operations of one submitted command buffer; loc names it in the call's parameters.
   auto For(VkCommandBuffer cb, const Location& loc) {
-    return [this, site = HistoryCheckSite{loc, cb, true, submission_}](const HistoryStore& store, const OpBatch& batch,
-                                                                       const AsOp& op) {
+    return [this, site = HistoryCheckSite{loc, cb, true, submission_, submitted_at_}](
+               const HistoryStore& store, const OpBatch& batch, const AsOp& op) {
       CheckOpHistory(ctx_.state, store, ctx_.enabled_checks, batch, op, site, findings_);
     };
   }
@@ -29,6 +31,7 @@ class SubmitChecks {
  private:
   const CheckContext& ctx_;
   uint64_t submission_ = 0;
+  uint64_t submitted_at_ = 0;
   HistoryFindings findings_;
 };
 

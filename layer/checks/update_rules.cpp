@@ -4,6 +4,7 @@
 
 #include "build_report.h"
 #include "layer_settings.h"
+#include "recorded_objects.h"
 #include "traced_structures.h"
 #include "vk_enum_string.h"
 
@@ -300,6 +301,7 @@ void CheckOpHistory(const DeviceState& state, const HistoryStore& store, uint32_
                     const OpBatch& batch, const AsOp& op, const HistoryCheckSite& site, HistoryFindings& out) {
   const OpReporter r{state, store, batch, op, site, out};
   const bool history = (enabled_checks & kCheckHistory) != 0;
+  if (enabled_checks & kCheckLifetime) CheckRecordedObjects(state, batch, op, site, out);
   switch (op.kind) {
     case OpKind::kBuild:
       if (history && op.is_update()) CheckUpdate(r);

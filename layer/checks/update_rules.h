@@ -25,6 +25,9 @@ struct HistoryCheckSite {
   VkCommandBuffer submitted = VK_NULL_HANDLE;      // the command buffer submitted (null for host calls)
   bool describe_origin = false;                    // prefix messages with where the operation was recorded
   uint64_t submission = 0;                         // SubmissionCaptures::id of the submission (0: host calls)
+  // DeviceState ids below this one were given before the app's submitting call (a deferred batch is applied later
+  // than its call): what was destroyed after it does not make the command buffer invalid at submission.
+  uint64_t submitted_at = 0;
 };
 
 // Checks `op` against the histories as they are before it executes. Call with the store's lock held.

@@ -20,7 +20,7 @@ inline void ApplyDeferredBatch(DeviceData& data, const DeferredBatch& batch, boo
   const CheckContext ctx = MakeCheckContext(data);
   HistorySubmission submission(data.state);
   submission.WithoutCaptures();
-  SubmitChecks checks(ctx, submission.captures().id);
+  SubmitChecks checks(ctx, submission.captures().id, batch.submitted_at);
   const bool submit2 = std::strcmp(batch.function, "vkQueueSubmit") != 0;
   const Location root(batch.function);
   std::size_t unchecked = 0;

@@ -161,7 +161,7 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
       std::shared_ptr<const RecordedOps> ops;
       if (!RecordedOf(data.state, cb, &ops)) return;
       if (place == Placement::kUnordered) unordered_ops += submission.ApplyUnordered(ops);
-      if (place == Placement::kDeferred) call->Defer(cb, i, j, ops);
+      if (place == Placement::kDeferred) call->Defer(cb, i, j, ops, submission.captures().id);
       if (ops && data.capture_tracker) {
         try {
           HoldDeferredLogs(*ops, submission.captures());

@@ -72,6 +72,9 @@ struct OpOrigin {
   uint32_t element = 0;     // pInfos[element] / pAccelerationStructures[element]
   VkCommandBuffer command_buffer = VK_NULL_HANDLE;  // where recorded; null for host calls
   VkCommandBuffer executed_by = VK_NULL_HANDLE;     // the primary that ran it, when recorded in a secondary
+  // DeviceState::LastObjectId() when recorded (0 for host calls): a structure created or a buffer bound later is
+  // not what the command named, one destroyed later leaves the command buffer invalid (layer/checks/recorded_objects.h).
+  uint64_t recorded_at = 0;
 };
 
 // "pInfos[0] of the 3rd vkCmdBuildAccelerationStructuresKHR in VkCommandBuffer 0x..." (allocates: reports only).
@@ -148,7 +151,7 @@ struct AsOp {
   }
 
   // The members are ordered by size within the groups below, so that the operation has no padding but the
-  // origin's (152 bytes: the batch's array grows and the command buffers copy them).
+  // origin's (160 bytes: the batch's array grows and the command buffers copy them).
   OpKind kind = OpKind::kBuild;
   // kBuild: the geometries could not be read (a null ppGeometries[j], or neither array given with
   // geometryCount > 0): an invalid build, reported by the structure family; what it leaves in dst is unknown.
@@ -185,7 +188,7 @@ struct AsOp {
   // completes (layer/checks/indirect_rules.h), not at submission.
   bool counts_captured() const { return origin.command == OpCommand::kCmdBuildIndirect && capture_log != nullptr; }
 };
-static_assert(sizeof(AsOp) == 152, "no padding but the origin's: see the member order");
+static_assert(sizeof(AsOp) == 160, "no padding but the origin's: see the member order");
 
 // A device address an operation reads or writes (issue 29: what a pending submission holds in use). The first
 // byte of each range is enough to name the buffer and memory behind it (a range of a valid command lies in one

@@ -13,6 +13,7 @@
 #include "build_size_cache.h"
 #include "command_buffers.h"
 #include "concurrent_map.h"
+#include "destroyed_objects.h"
 #include "failure_injection.h"
 #include "history_state.h"
 #include "format_features.h"
@@ -112,6 +113,10 @@ class DeviceState {
     std::atomic<uint64_t> kept_back{0};       // destroys the layer made later (skipped by the app or protect mode)
     std::atomic<uint64_t> skipped_no_fence{0};       // batches with no fence to ask
     std::atomic<uint64_t> skipped_host_may_know{0};  // batches the host may know complete before their fence
+    // At submission (layer/checks/recorded_objects.h): recorded objects found destroyed since the recording, and
+    // those whose destruction the layer no longer remembers (DestroyedObjects' ring passed them).
+    std::atomic<uint64_t> recorded_judged{0};
+    std::atomic<uint64_t> skipped_recorded_forgotten{0};
   };
   mutable LifetimeCounters lifetime_counters;
   // Family traces: the structures judged at submission, and why others were not (TracedSkip order).
@@ -122,6 +127,8 @@ class DeviceState {
   mutable TraceCounters trace_counters;
   // Shader modules, pipelines, layouts, templates and descriptor sets that hold acceleration structures.
   RayBindings ray_bindings;
+  // Structures and buffers destroyed lately (family lifetime): a command recorded before is judged at submission.
+  DestroyedObjects destroyed;
   // Calls protect mode kept from the driver, and whether an error judged at completion halted submissions
   // (protect_marks.h).
   ProtectCounters protect_counters;
@@ -129,6 +136,9 @@ class DeviceState {
 
   // A fresh id, unique on this device (BufferState::id).
   uint64_t NextObjectId() { return next_object_id_.fetch_add(1, std::memory_order_relaxed) + 1; }
+  // The newest id given so far: an object created, bound or destroyed after this read gets a larger one. A command
+  // records it (OpOrigin::recorded_at) without taking an id (a load, not a read-modify-write, per recorded command).
+  uint64_t LastObjectId() const { return next_object_id_.load(std::memory_order_relaxed); }
 
  private:
   std::atomic<uint64_t> next_object_id_{0};

@@ -19,6 +19,8 @@ const char* UnknownReasonText(UnknownReason reason) {
     case UnknownReason::kLostOperations:
       return "written by a command buffer the layer did not see recorded, or whose operations it could not record";
     case UnknownReason::kUnreadableBuild: return "built by an invalid build whose geometries could not be read";
+    case UnknownReason::kStaleHandle:
+      return "written by a command recorded with a structure destroyed since, whose handle this structure reuses";
   }
   return "";
 }

@@ -56,6 +56,7 @@ enum class UnknownReason : uint8_t {
   kCopiedFromUnknown,         // cloned, compacted or deserialized from a structure whose history is unknown
   kLostOperations,            // the layer could not record an operation (allocation failure) or a command buffer
   kUnreadableBuild,           // built by an invalid build whose geometries could not be read
+  kStaleHandle,               // written by a command recorded with a structure destroyed since (its handle reused)
 };
 const char* UnknownReasonText(UnknownReason reason);
 

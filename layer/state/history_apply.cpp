@@ -443,6 +443,46 @@ void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn)
   store.SetSlot(op.query_pool, op.query, QuerySlot{op.dst, h ? h->generation : 0, op.query_type}, txn);
 }
 
+// A device command recorded before a structure it names was destroyed, whose handle now names a structure created
+// after the recording: the command buffer is invalid (reported by layer/checks/recorded_objects.h), and what the
+// command does with the stale handle is not defined. Destroys are rare: two loads while none followed the recording.
+bool NamesReplacedStructure(const DeviceState& state, const AsOp& op) {
+  const uint64_t recorded_at = op.origin.recorded_at;
+  if (recorded_at == 0 || op.kind == OpKind::kTrace || state.destroyed.last_structure_destroyed() <= recorded_at) {
+    return false;
+  }
+  const auto replaced = [&](VkAccelerationStructureKHR as) {
+    if (!as) return false;
+    const std::optional<std::shared_ptr<const AccelerationStructureState>> now = state.acceleration_structures.find(as);
+    return now && *now && (*now)->serial > recorded_at;
+  };
+  return replaced(op.src) || replaced(op.dst);
+}
+
+// Never guessed: the structure under the destination handle (the newer one, or one written from it) becomes unknown,
+// a property query of it names no contents, and a serialization may have written any serialized bytes.
+void ApplyOnReplaced(const DeviceState& state, HistoryStore& store, const AsOp& op, Transaction* txn) {
+  switch (op.kind) {
+    case OpKind::kBuild:
+    case OpKind::kCopy:
+    case OpKind::kDeserialize:
+      if (std::optional<Written> fresh = Fresh(state, store, op.dst)) {
+        fresh->history.kind = HistoryKind::kUnknown;
+        fresh->history.unknown_reason = UnknownReason::kStaleHandle;
+        store.Set(op.dst, std::move(fresh->history), txn);
+        store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+      }
+      return;
+    case OpKind::kWriteProperties:
+      if (op.query_pool) store.SetSlot(op.query_pool, op.query, QuerySlot{op.dst, 0, op.query_type}, txn);
+      return;
+    case OpKind::kSerialize:
+      store.InvalidateAllBlobs(txn);
+      return;
+    case OpKind::kTrace: return;
+  }
+}
+
 }  // namespace
 
 std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as) {
@@ -480,6 +520,7 @@ void MakeAllUnknownAfterFailure(const DeviceState& state, HistoryStore& store) {
 void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
              SubmissionCaptures* captures) {
   InjectBadAlloc(FailSite::kApply);  // the test hook: as if this operation's first allocation failed
+  if (NamesReplacedStructure(state, op)) return ApplyOnReplaced(state, store, op, txn);
   switch (op.kind) {
     case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
     case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;

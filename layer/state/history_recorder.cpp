@@ -54,11 +54,12 @@ OpBatch LostHostOps() {
   return lost;
 }
 
-OpOrigin DeviceOrigin(CommandBufferState& state, OpCommand command, VkCommandBuffer cb) {
+OpOrigin DeviceOrigin(const DeviceState& device, CommandBufferState& state, OpCommand command, VkCommandBuffer cb) {
   OpOrigin origin;
   origin.command = command;
   origin.ordinal = state.NextOrdinal(command);
   origin.command_buffer = cb;
+  origin.recorded_at = device.LastObjectId();
   return origin;
 }
 
@@ -146,7 +147,7 @@ void RecordCmdBuild(DeviceState& state, VkCommandBuffer cb, OpCommand command, u
                     const uint32_t* captured) {
   CommandBufferState* recording = RecordingBuild(state, cb, last ? *last : ThisThreadsLastRecordedBuild());
   if (!recording || !infos) return;
-  const OpOrigin origin = DeviceOrigin(*recording, command, cb);
+  const OpOrigin origin = DeviceOrigin(state, *recording, command, cb);
   Guarded(state, *recording, [&] {
     recording->recording.AppendBuilds(origin, info_count, infos, ranges, recording->capture_log.get(), captured,
                                       state.properties.acceleration_structure.maxGeometryCount, state.lifetime_tracked);
@@ -157,7 +158,7 @@ void RecordCmdCopy(DeviceState& state, VkCommandBuffer cb, const VkCopyAccelerat
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kCopy, info.src, info.dst, info.mode);
-  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopy, cb);
+  op.origin = DeviceOrigin(state, *recording, OpCommand::kCmdCopy, cb);
   Guarded(state, *recording, [&] { recording->recording.Append(op); });
 }
 
@@ -166,7 +167,7 @@ void RecordCmdCopyToMemory(DeviceState& state, VkCommandBuffer cb,
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kSerialize, info.src, VK_NULL_HANDLE, info.mode);
-  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyToMemory, cb);
+  op.origin = DeviceOrigin(state, *recording, OpCommand::kCmdCopyToMemory, cb);
   AttachBlobCapture(*recording, captured, op);
   Guarded(state, *recording, [&] {
     op.memory = ResolveDeviceLocation(state, info.dst.deviceAddress);  // may allocate (many buffers there)
@@ -179,7 +180,7 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording) return;
   AsOp op = CopyKindOp(OpKind::kDeserialize, VK_NULL_HANDLE, info.dst, info.mode);
-  op.origin = DeviceOrigin(*recording, OpCommand::kCmdCopyMemoryTo, cb);
+  op.origin = DeviceOrigin(state, *recording, OpCommand::kCmdCopyMemoryTo, cb);
   AttachBlobCapture(*recording, captured, op);
   Guarded(state, *recording, [&] {
     op.memory = ResolveDeviceLocation(state, info.src.deviceAddress);  // may allocate (many buffers there)
@@ -192,7 +193,7 @@ void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t c
                               uint32_t first_query) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording || !structures) return;
-  const OpOrigin origin = DeviceOrigin(*recording, OpCommand::kCmdWriteProperties, cb);
+  const OpOrigin origin = DeviceOrigin(state, *recording, OpCommand::kCmdWriteProperties, cb);
   Guarded(state, *recording, [&] {
     for (uint32_t i = 0; i < count; ++i) {
       AsOp op;

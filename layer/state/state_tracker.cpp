@@ -212,6 +212,10 @@ void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer) {
   std::optional<std::shared_ptr<const BufferState>> record = state.buffers.pop(buffer);
   if (record && *record && (*record)->device_address != 0) {
     state.buffer_addresses.Erase((*record)->device_address, buffer);
+    if (state.lifetime_tracked) {
+      const BufferState& b = **record;
+      state.destroyed.AddBuffer({buffer, b.device_address, b.size, b.bound_serial, state.NextObjectId()});
+    }
   }
   if (record && *record && ((*record)->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR)) {
     state.structure_storage_changes.Bump();
@@ -291,6 +295,9 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
 
 void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
   std::optional<std::shared_ptr<const AccelerationStructureState>> record = state.acceleration_structures.pop(handle);
+  if (record && *record && state.lifetime_tracked) {
+    state.destroyed.AddStructure({handle, (*record)->serial, state.NextObjectId()});
+  }
   if (record && *record && (*record)->address == AccelerationStructureState::Address::kAwaitingBind) {
     state.structures_awaiting_address.fetch_sub(1, std::memory_order_relaxed);
   }

@@ -173,8 +173,9 @@ Placement SubmissionOrder::Call::Place(const BatchSemaphores& batch) {
 }
 
 void SubmissionOrder::Call::Defer(VkCommandBuffer cb, uint32_t submit_index, uint32_t cb_index,
-                                  std::shared_ptr<const RecordedOps> ops) {
+                                  std::shared_ptr<const RecordedOps> ops, uint64_t submitted_at) {
   DeferredBatch& batch = deferred_.back();
+  batch.submitted_at = submitted_at;
   try {
     batch.command_buffers.push_back(DeferredCommandBuffer{cb, submit_index, cb_index, std::move(ops)});
   } catch (const std::bad_alloc&) {

@@ -73,6 +73,9 @@ struct DeferredBatch {
   uint64_t id = 0;
   VkQueue queue = VK_NULL_HANDLE;
   const char* function = nullptr;  // vkQueueSubmit or vkQueueSubmit2
+  // The id of the submission that made it (SubmissionCaptures::id): objects destroyed after that call are not what
+  // its command buffers' state was judged on (layer/checks/recorded_objects.h).
+  uint64_t submitted_at = 0;
   std::vector<SemaphoreUse> timeline_waits;
   std::vector<uint64_t> after;  // deferred batches whose binary signals it waits for
   std::vector<SemaphoreUse> signals;
@@ -120,7 +123,9 @@ class SubmissionOrder {
     // The next batch of the call. kNow and kUnordered: its timeline signals count as signaled from now on.
     Placement Place(const BatchSemaphores& batch);
     // A command buffer of the batch Place just deferred, in order. Throws std::bad_alloc.
-    void Defer(VkCommandBuffer cb, uint32_t submit_index, uint32_t cb_index, std::shared_ptr<const RecordedOps> ops);
+    // submitted_at: the submission's id (SubmissionCaptures::id), kept for the checks made when the batch is applied.
+    void Defer(VkCommandBuffer cb, uint32_t submit_index, uint32_t cb_index, std::shared_ptr<const RecordedOps> ops,
+               uint64_t submitted_at);
     // The downcall succeeded: the deferred batches join the backlog.
     void Commit();
 

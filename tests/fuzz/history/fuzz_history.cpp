@@ -679,6 +679,7 @@ class Harness {
       case UnknownReason::kCopiedFromUnknown: return ModelUnknown::kCopiedFromUnknown;
       case UnknownReason::kLostOperations: return ModelUnknown::kLostOperations;
       case UnknownReason::kUnreadableBuild: return ModelUnknown::kUnreadableBuild;
+      case UnknownReason::kStaleHandle: return ModelUnknown::kStaleHandle;
     }
     return ModelUnknown::kNone;
   }

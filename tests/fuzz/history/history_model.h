@@ -41,7 +41,9 @@ struct ModelParams {
 
 enum class ModelKind { kNeverBuilt, kBuilt, kUnknown };
 enum class ModelUnknown { kNone, kDeserializedUnknownBytes, kDeserializedDeviceBytes, kCopiedFromUnknown,
-                          kLostOperations, kUnreadableBuild };
+                          kLostOperations, kUnreadableBuild,
+                          kStaleHandle };  // never made by the model: its operations are host calls or
+                                           // recorded after every structure they name was created
 
 struct ModelHistory {
   ModelKind kind = ModelKind::kNeverBuilt;
