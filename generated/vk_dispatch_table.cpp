@@ -50,6 +50,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CmdBeginRenderPass2 = reinterpret_cast<PFN_vkCmdBeginRenderPass2>(LoadFirst(gdpa, device, kCmdBeginRenderPass2Names));
   static constexpr const char* kCmdBeginRenderingNames[] = {"vkCmdBeginRendering", "vkCmdBeginRenderingKHR"};
   table->CmdBeginRendering = reinterpret_cast<PFN_vkCmdBeginRendering>(LoadFirst(gdpa, device, kCmdBeginRenderingNames));
+  table->CmdBindDescriptorBuffersEXT = reinterpret_cast<PFN_vkCmdBindDescriptorBuffersEXT>(gdpa(device, "vkCmdBindDescriptorBuffersEXT"));
   table->CmdBindDescriptorSets = reinterpret_cast<PFN_vkCmdBindDescriptorSets>(gdpa(device, "vkCmdBindDescriptorSets"));
   table->CmdBindPipeline = reinterpret_cast<PFN_vkCmdBindPipeline>(gdpa(device, "vkCmdBindPipeline"));
   table->CmdBuildAccelerationStructuresIndirectKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(gdpa(device, "vkCmdBuildAccelerationStructuresIndirectKHR"));
@@ -85,6 +86,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CmdResetEvent = reinterpret_cast<PFN_vkCmdResetEvent>(gdpa(device, "vkCmdResetEvent"));
   static constexpr const char* kCmdResetEvent2Names[] = {"vkCmdResetEvent2", "vkCmdResetEvent2KHR"};
   table->CmdResetEvent2 = reinterpret_cast<PFN_vkCmdResetEvent2>(LoadFirst(gdpa, device, kCmdResetEvent2Names));
+  table->CmdSetDescriptorBufferOffsetsEXT = reinterpret_cast<PFN_vkCmdSetDescriptorBufferOffsetsEXT>(gdpa(device, "vkCmdSetDescriptorBufferOffsetsEXT"));
   table->CmdSetEvent = reinterpret_cast<PFN_vkCmdSetEvent>(gdpa(device, "vkCmdSetEvent"));
   static constexpr const char* kCmdSetEvent2Names[] = {"vkCmdSetEvent2", "vkCmdSetEvent2KHR"};
   table->CmdSetEvent2 = reinterpret_cast<PFN_vkCmdSetEvent2>(LoadFirst(gdpa, device, kCmdSetEvent2Names));
@@ -141,6 +143,8 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->GetBufferDeviceAddress = reinterpret_cast<PFN_vkGetBufferDeviceAddress>(LoadFirst(gdpa, device, kGetBufferDeviceAddressNames));
   table->GetBufferMemoryRequirements = reinterpret_cast<PFN_vkGetBufferMemoryRequirements>(gdpa(device, "vkGetBufferMemoryRequirements"));
   table->GetDeferredOperationResultKHR = reinterpret_cast<PFN_vkGetDeferredOperationResultKHR>(gdpa(device, "vkGetDeferredOperationResultKHR"));
+  table->GetDescriptorEXT = reinterpret_cast<PFN_vkGetDescriptorEXT>(gdpa(device, "vkGetDescriptorEXT"));
+  table->GetDescriptorSetLayoutBindingOffsetEXT = reinterpret_cast<PFN_vkGetDescriptorSetLayoutBindingOffsetEXT>(gdpa(device, "vkGetDescriptorSetLayoutBindingOffsetEXT"));
   static constexpr const char* kGetDeviceBufferMemoryRequirementsNames[] = {"vkGetDeviceBufferMemoryRequirements", "vkGetDeviceBufferMemoryRequirementsKHR"};
   table->GetDeviceBufferMemoryRequirements = reinterpret_cast<PFN_vkGetDeviceBufferMemoryRequirements>(LoadFirst(gdpa, device, kGetDeviceBufferMemoryRequirementsNames));
   table->GetDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(gdpa(device, "vkGetDeviceProcAddr"));

@@ -35,6 +35,7 @@ struct DeviceDispatchTable {
   PFN_vkCmdBeginRenderPass CmdBeginRenderPass = nullptr;
   PFN_vkCmdBeginRenderPass2 CmdBeginRenderPass2 = nullptr;
   PFN_vkCmdBeginRendering CmdBeginRendering = nullptr;
+  PFN_vkCmdBindDescriptorBuffersEXT CmdBindDescriptorBuffersEXT = nullptr;
   PFN_vkCmdBindDescriptorSets CmdBindDescriptorSets = nullptr;
   PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR CmdBuildAccelerationStructuresIndirectKHR = nullptr;
@@ -65,6 +66,7 @@ struct DeviceDispatchTable {
   PFN_vkCmdPushDescriptorSetWithTemplateKHR CmdPushDescriptorSetWithTemplateKHR = nullptr;
   PFN_vkCmdResetEvent CmdResetEvent = nullptr;
   PFN_vkCmdResetEvent2 CmdResetEvent2 = nullptr;
+  PFN_vkCmdSetDescriptorBufferOffsetsEXT CmdSetDescriptorBufferOffsetsEXT = nullptr;
   PFN_vkCmdSetEvent CmdSetEvent = nullptr;
   PFN_vkCmdSetEvent2 CmdSetEvent2 = nullptr;
   PFN_vkCmdTraceRaysIndirect2KHR CmdTraceRaysIndirect2KHR = nullptr;
@@ -116,6 +118,8 @@ struct DeviceDispatchTable {
   PFN_vkGetBufferDeviceAddress GetBufferDeviceAddress = nullptr;
   PFN_vkGetBufferMemoryRequirements GetBufferMemoryRequirements = nullptr;
   PFN_vkGetDeferredOperationResultKHR GetDeferredOperationResultKHR = nullptr;
+  PFN_vkGetDescriptorEXT GetDescriptorEXT = nullptr;
+  PFN_vkGetDescriptorSetLayoutBindingOffsetEXT GetDescriptorSetLayoutBindingOffsetEXT = nullptr;
   PFN_vkGetDeviceBufferMemoryRequirements GetDeviceBufferMemoryRequirements = nullptr;
   PFN_vkGetDeviceProcAddr GetDeviceProcAddr = nullptr;
   PFN_vkGetDeviceQueue GetDeviceQueue = nullptr;

@@ -19,6 +19,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdBeginRenderPass2KHR",
     "vkCmdBeginRendering",
     "vkCmdBeginRenderingKHR",
+    "vkCmdBindDescriptorBuffersEXT",
     "vkCmdBindDescriptorSets",
     "vkCmdBindPipeline",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
@@ -55,6 +56,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdResetEvent",
     "vkCmdResetEvent2",
     "vkCmdResetEvent2KHR",
+    "vkCmdSetDescriptorBufferOffsetsEXT",
     "vkCmdSetEvent",
     "vkCmdSetEvent2",
     "vkCmdSetEvent2KHR",
@@ -79,6 +81,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateDevice",
     "vkCreateGraphicsPipelines",
     "vkCreateInstance",
+    "vkCreatePipelineLayout",
     "vkCreateQueryPool",
     "vkCreateRayTracingPipelinesKHR",
     "vkCreateSemaphore",
@@ -97,6 +100,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkDestroyFence",
     "vkDestroyInstance",
     "vkDestroyPipeline",
+    "vkDestroyPipelineLayout",
     "vkDestroyQueryPool",
     "vkDestroySemaphore",
     "vkDestroyShaderModule",
@@ -106,6 +110,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkFreeDescriptorSets",
     "vkFreeMemory",
     "vkGetDeferredOperationResultKHR",
+    "vkGetDescriptorEXT",
     "vkGetDeviceBufferMemoryRequirements",
     "vkGetDeviceBufferMemoryRequirementsKHR",
     "vkGetEventStatus",
@@ -151,6 +156,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdBeginRenderPass2KHR
     true,  // vkCmdBeginRendering
     true,  // vkCmdBeginRenderingKHR
+    true,  // vkCmdBindDescriptorBuffersEXT
     true,  // vkCmdBindDescriptorSets
     true,  // vkCmdBindPipeline
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
@@ -187,6 +193,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdResetEvent
     true,  // vkCmdResetEvent2
     true,  // vkCmdResetEvent2KHR
+    true,  // vkCmdSetDescriptorBufferOffsetsEXT
     true,  // vkCmdSetEvent
     true,  // vkCmdSetEvent2
     true,  // vkCmdSetEvent2KHR
@@ -211,6 +218,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     false,  // vkCreateDevice
     true,  // vkCreateGraphicsPipelines
     false,  // vkCreateInstance
+    true,  // vkCreatePipelineLayout
     true,  // vkCreateQueryPool
     true,  // vkCreateRayTracingPipelinesKHR
     true,  // vkCreateSemaphore
@@ -229,6 +237,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkDestroyFence
     false,  // vkDestroyInstance
     true,  // vkDestroyPipeline
+    true,  // vkDestroyPipelineLayout
     true,  // vkDestroyQueryPool
     true,  // vkDestroySemaphore
     true,  // vkDestroyShaderModule
@@ -238,6 +247,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkFreeDescriptorSets
     true,  // vkFreeMemory
     true,  // vkGetDeferredOperationResultKHR
+    true,  // vkGetDescriptorEXT
     true,  // vkGetDeviceBufferMemoryRequirements
     true,  // vkGetDeviceBufferMemoryRequirementsKHR
     true,  // vkGetEventStatus

@@ -7,7 +7,7 @@
 
 namespace asval::hooks {
 
-inline constexpr std::size_t kInterceptNameCount = 129;
+inline constexpr std::size_t kInterceptNameCount = 134;
 
 // Sorted by strcmp, no duplicates.
 extern const char* const kInterceptNames[kInterceptNameCount];

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "address_map.h"
 #include "build_report.h"
 #include "structure_memory.h"
 
@@ -30,7 +31,66 @@ struct TracedJudge {
     if (b.source == TracedSource::kPushed) {
       return fmt::format("pushed at set {} binding {}", b.set_index, b.binding);
     }
+    if (b.source == TracedSource::kBuffer) {
+      return fmt::format("through the descriptor buffer bytes at 0x{:x}, set {} binding {}", b.descriptor_address,
+                         b.set_index, b.binding);
+    }
     return fmt::format("through VkDescriptorSet {} bound at set {}, binding {}", Hex(b.set), b.set_index, b.binding);
+  }
+
+  // The descriptors of a binding read from a descriptor buffer: their bytes now, from the app's host mapping of the
+  // memory under the buffer (a valid app wrote them before submitting), turned back into the structure address that
+  // vkGetDescriptorEXT made them from, and that address into the live structure there.
+  void JudgeBuffer(const TracedBinding& b) const {
+    const std::size_t size = state.ray_bindings.structure_descriptor_size();
+    if (size == 0) return Skip(TracedSkip::kUnreadable);  // no structure descriptor was made through the layer
+    std::shared_ptr<const LiveStructureAddresses> live;
+    for (uint32_t i = 0; i < b.descriptor_count; ++i) {
+      const unsigned char* bytes = HostBytes(b.descriptor_address + VkDeviceSize{i} * size, size);
+      if (!bytes) {
+        Skip(TracedSkip::kUnreadable);
+        continue;
+      }
+      VkDeviceAddress address = 0;
+      if (!state.ray_bindings.StructureOfDescriptor(bytes, size, &address)) {
+        Skip(TracedSkip::kUnknownStructure);
+        continue;
+      }
+      if (address == 0) continue;  // a null descriptor: nothing is read
+      if (!live) {
+        live = state.live_structure_addresses.Get(
+            state.acceleration_structures, state.structure_storage_changes.Read(),
+            [&](const AccelerationStructureState& s) { return StorageOfStructure(state, s); },
+            state.failures().structures_incomplete.load(std::memory_order_relaxed));
+      }
+      const std::ptrdiff_t k = live->Find(address);
+      // No live structure there (destroyed since the descriptor was made), or several: which one is not known.
+      if (k < 0 || live->shared[static_cast<std::size_t>(k)]) {
+        Skip(TracedSkip::kUnknownStructure);
+        continue;
+      }
+      const AccelerationStructureState& s = *live->structures[static_cast<std::size_t>(k)];
+      Judge(b, DescribedStructure{s.handle, s.serial});
+    }
+  }
+
+  // `size` bytes at a device address, where the app mapped the memory under a buffer holding them; null otherwise.
+  const unsigned char* HostBytes(VkDeviceAddress address, std::size_t size) const {
+    AddressHits hits;
+    state.buffer_addresses.FindContaining(address, hits);
+    for (const AddressHit& hit : hits) {
+      const std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(hit.buffer);
+      if (!buffer || !*buffer || !(*buffer)->bound || (*buffer)->memory_freed) continue;
+      const BufferState& bs = **buffer;
+      if (!bs.Contains(address - bs.device_address, size)) continue;
+      const std::optional<HostMapping> mapping = state.host_mappings.OfMemory(bs.memory);
+      if (!mapping) continue;
+      const VkDeviceSize at = bs.memory_offset + (address - bs.device_address);
+      const VkDeviceSize mapped = mapping->end - mapping->begin;
+      if (at < mapping->offset || at - mapping->offset > mapped || size > mapped - (at - mapping->offset)) continue;
+      return reinterpret_cast<const unsigned char*>(mapping->begin + (at - mapping->offset));
+    }
+    return nullptr;
   }
 
   void Judge(const TracedBinding& b, const DescribedStructure& d) const {
@@ -190,6 +250,9 @@ void CheckTracedStructures(const DeviceState& state, const HistoryStore& store, 
         break;
       case TracedSource::kPushed:
         judge.Judge(b, DescribedStructure{b.pushed, b.pushed_serial});
+        break;
+      case TracedSource::kBuffer:
+        judge.JudgeBuffer(b);
         break;
       case TracedSource::kSet: {
         const SetLookup found =

@@ -1,15 +1,16 @@
 #pragma once
 // Family "traces" (issue 29): the top-level structures that trace and ray-query work reads are built, in execution
-// order. At submission each vkCmdTraceRays*, vkCmdDispatch* and vkCmdDraw* whose bound pipeline statically uses structure
-// descriptors (shader_structure_use.h) is judged, just before it executes in the submission's order: every
+// order. At submission each vkCmdTraceRays*, vkCmdDispatch* and vkCmdDraw* whose bound pipeline statically uses
+// structure descriptors (shader_structure_use.h) is judged, just before it executes in the submission's order: every
 // structure in those descriptors (the set bound at that set number when the command was recorded, read as it is at
-// submission; or the structures pushed there) must have had a build execute on it, and that build must have made a
-// top-level structure (VUID-RuntimeSpirv-OpTraceRayKHR-06359 for pipelines that trace,
-// VUID-RuntimeSpirv-OpRayQueryInitializeKHR-06352 for ray queries).
+// submission; or the structures pushed there; or the descriptor-buffer bytes bound there, read at submission) must
+// have had a build execute on it, and that build must have made a top-level structure
+// (VUID-RuntimeSpirv-OpTraceRayKHR-06359 for pipelines that trace, VUID-RuntimeSpirv-OpRayQueryInitializeKHR-06352
+// for ray queries).
 //
 // Not judged, counted by reason (TracedSkip; the summary at vkDestroyDevice): nothing bound or written there,
-// descriptors the layer cannot read (push templates, descriptor buffers, writes past a binding's end), a structure
-// the layer did not know when written or destroyed since (a handle is not an identity), unknown histories.
+// descriptors the layer cannot read (push templates, unmapped descriptor buffers, writes past a binding's end), a
+// structure the layer did not know when written or destroyed since (a handle is not an identity), unknown histories.
 // Structures a shader reaches from an address (OpConvertUToAccelerationStructureKHR) cannot be seen: nothing is
 // judged or counted for them. Draws are judged like dispatches (ray queries in graphics and mesh pipelines).
 #include "device_state.h"
@@ -21,7 +22,7 @@ namespace asval {
 enum class TracedSkip : uint8_t {
   kNotBound,           // no set bound (or pushed) at that set number
   kNotWritten,         // the set's binding holds no structure the layer saw written
-  kUnreadable,         // descriptors the layer does not read (templates pushed, descriptor buffers, ...)
+  kUnreadable,         // descriptors the layer does not read (templates pushed, unmapped descriptor buffers, ...)
   kUnknownStructure,   // a structure the layer did not know when it was written
   kDestroyed,          // destroyed since it was written (its descriptor is stale)
   kUnknownHistory,     // the structure's history is unknown

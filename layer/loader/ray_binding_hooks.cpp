@@ -2,6 +2,8 @@
 // descriptors, the descriptors written into sets, the sets bound, and the traces and dispatches that read them
 // (layer/state/ray_recorder.h). Each is passed down unchanged first; the layer records what succeeded. Destroys are
 // recorded before the downcall: afterwards another thread may be handed the same handle value.
+#include <functional>
+
 #include "layer_data.h"
 #include "ray_recorder.h"
 #include "vk_intercepts.h"
@@ -77,8 +79,41 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDescriptorSetLayout(VkDevice device,
                                                          VkDescriptorSetLayout* pSetLayout) {
   DeviceData* data = GetDeviceData(device);
   const VkResult result = data->dispatch.CreateDescriptorSetLayout(device, pCreateInfo, pAllocator, pSetLayout);
-  if (result == VK_SUCCESS && pCreateInfo) RecordCreateDescriptorSetLayout(data->state, *pCreateInfo, *pSetLayout);
+  if (result != VK_SUCCESS || !pCreateInfo) return result;
+  // A descriptor-buffer layout's binding offsets, asked of the driver (the app may ask the same).
+  const PFN_vkGetDescriptorSetLayoutBindingOffsetEXT offset = data->dispatch.GetDescriptorSetLayoutBindingOffsetEXT;
+  const VkDescriptorSetLayout layout = *pSetLayout;
+  const auto offset_of = [&](uint32_t binding) {
+    VkDeviceSize at = 0;
+    offset(device, layout, binding, &at);
+    return at;
+  };
+  RecordCreateDescriptorSetLayout(data->state, *pCreateInfo, layout,
+                                  offset ? std::function<VkDeviceSize(uint32_t)>(offset_of) : nullptr);
   return result;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL CreatePipelineLayout(VkDevice device, const VkPipelineLayoutCreateInfo* pCreateInfo,
+                                                    const VkAllocationCallbacks* pAllocator,
+                                                    VkPipelineLayout* pPipelineLayout) {
+  DeviceData* data = GetDeviceData(device);
+  const VkResult result = data->dispatch.CreatePipelineLayout(device, pCreateInfo, pAllocator, pPipelineLayout);
+  if (result == VK_SUCCESS && pCreateInfo) RecordCreatePipelineLayout(data->state, *pCreateInfo, *pPipelineLayout);
+  return result;
+}
+
+VKAPI_ATTR void VKAPI_CALL DestroyPipelineLayout(VkDevice device, VkPipelineLayout pipelineLayout,
+                                                 const VkAllocationCallbacks* pAllocator) {
+  DeviceData* data = GetDeviceData(device);
+  RecordDestroyPipelineLayout(data->state, pipelineLayout);
+  data->dispatch.DestroyPipelineLayout(device, pipelineLayout, pAllocator);
+}
+
+VKAPI_ATTR void VKAPI_CALL GetDescriptorEXT(VkDevice device, const VkDescriptorGetInfoEXT* pDescriptorInfo,
+                                            size_t dataSize, void* pDescriptor) {
+  DeviceData* data = GetDeviceData(device);
+  data->dispatch.GetDescriptorEXT(device, pDescriptorInfo, dataSize, pDescriptor);
+  if (pDescriptorInfo && pDescriptor) RecordGetDescriptor(data->state, *pDescriptorInfo, dataSize, pDescriptor);
 }
 
 VKAPI_ATTR void VKAPI_CALL DestroyDescriptorSetLayout(VkDevice device, VkDescriptorSetLayout descriptorSetLayout,
@@ -166,6 +201,25 @@ VKAPI_ATTR void VKAPI_CALL CmdBindDescriptorSets(VkCommandBuffer commandBuffer, 
                                        pDescriptorSets, dynamicOffsetCount, pDynamicOffsets);
   RecordBindDescriptorSets(data->state, commandBuffer, pipelineBindPoint, firstSet, descriptorSetCount,
                            pDescriptorSets);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdBindDescriptorBuffersEXT(VkCommandBuffer commandBuffer, uint32_t bufferCount,
+                                                       const VkDescriptorBufferBindingInfoEXT* pBindingInfos) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdBindDescriptorBuffersEXT(commandBuffer, bufferCount, pBindingInfos);
+  RecordBindDescriptorBuffers(data->state, commandBuffer, bufferCount, pBindingInfos);
+}
+
+VKAPI_ATTR void VKAPI_CALL CmdSetDescriptorBufferOffsetsEXT(VkCommandBuffer commandBuffer,
+                                                            VkPipelineBindPoint pipelineBindPoint,
+                                                            VkPipelineLayout layout, uint32_t firstSet,
+                                                            uint32_t setCount, const uint32_t* pBufferIndices,
+                                                            const VkDeviceSize* pOffsets) {
+  DeviceData* data = GetDeviceData(commandBuffer);
+  data->dispatch.CmdSetDescriptorBufferOffsetsEXT(commandBuffer, pipelineBindPoint, layout, firstSet, setCount,
+                                                  pBufferIndices, pOffsets);
+  RecordSetDescriptorBufferOffsets(data->state, commandBuffer, pipelineBindPoint, layout, firstSet, setCount,
+                                   pBufferIndices, pOffsets);
 }
 
 VKAPI_ATTR void VKAPI_CALL CmdPushDescriptorSetKHR(VkCommandBuffer commandBuffer, VkPipelineBindPoint pipelineBindPoint,

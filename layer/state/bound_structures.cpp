@@ -19,6 +19,8 @@ TracedBinding Row(const SetBinding& b, TracedSource source, TracedBy by) {
   row.set = VK_NULL_HANDLE;
   row.pushed = VK_NULL_HANDLE;
   row.pushed_serial = 0;
+  row.descriptor_count = 0;
+  row.descriptor_address = 0;
   return row;
 }
 
@@ -29,6 +31,24 @@ void BoundStructures::BindSets(Point point, uint32_t first_set, uint32_t count, 
   for (uint32_t i = 0; sets && i < count; ++i) {
     At(b.sets, first_set + i) = sets[i];
     if (first_set + i < b.pushed_sets.size()) b.pushed_sets[first_set + i] = PushState::kNone;
+    if (first_set + i < b.buffer_sets.size()) b.buffer_sets[first_set + i] = BufferSet{};
+  }
+}
+
+void BoundStructures::BindDescriptorBuffers(uint32_t count, const VkDescriptorBufferBindingInfoEXT* infos) {
+  descriptor_buffers_.assign(count, 0);
+  for (uint32_t i = 0; infos && i < count; ++i) descriptor_buffers_[i] = infos[i].address;
+}
+
+void BoundStructures::SetBufferOffsets(
+    Point point, uint32_t first_set, uint32_t count, const uint32_t* indices, const VkDeviceSize* offsets,
+    const std::vector<std::shared_ptr<const RayBindings::BufferBindings>>& bindings) {
+  Bound& b = bound_[point];
+  for (uint32_t i = 0; indices && offsets && i < count; ++i) {
+    const uint32_t set = first_set + i;
+    At(b.buffer_sets, set) = BufferSet{true, indices[i], offsets[i], i < bindings.size() ? bindings[i] : nullptr};
+    if (set < b.sets.size()) b.sets[set] = VK_NULL_HANDLE;
+    if (set < b.pushed_sets.size()) b.pushed_sets[set] = PushState::kNone;
   }
 }
 
@@ -64,6 +84,23 @@ void BoundStructures::PushUnknown(Point point, uint32_t set) {
   bound_[point].pushed_sets[set] = PushState::kUnknown;
 }
 
+TracedBinding BoundStructures::BufferRow(const Bound& b, const SetBinding& sb, TracedBy by) const {
+  const BufferSet* set = sb.set < b.buffer_sets.size() && b.buffer_sets[sb.set].set ? &b.buffer_sets[sb.set] : nullptr;
+  if (!set || set->index >= descriptor_buffers_.size() || descriptor_buffers_[set->index] == 0) {
+    return Row(sb, TracedSource::kNotBound, by);
+  }
+  // The layout's structure bindings were not known (its offsets could not be asked): the descriptors are not read.
+  if (!set->bindings) return Row(sb, TracedSource::kUnknown, by);
+  for (const RayBindings::BufferBinding& binding : *set->bindings) {
+    if (binding.binding != sb.binding) continue;
+    TracedBinding row = Row(sb, TracedSource::kBuffer, by);
+    row.descriptor_address = descriptor_buffers_[set->index] + set->offset + binding.offset;
+    row.descriptor_count = binding.count;
+    return row;
+  }
+  return Row(sb, TracedSource::kUnknown, by);
+}
+
 void BoundStructures::MakeTraced(Point point, bool traces, std::vector<TracedBinding>& out) const {
   const Bound& b = bound_[point];
   if (!b.pipeline) return;
@@ -71,12 +108,10 @@ void BoundStructures::MakeTraced(Point point, bool traces, std::vector<TracedBin
   // A trace command's pipeline reads its structures through OpTraceRayKHR when it has one; ray queries otherwise.
   const TracedBy by = traces && use.traces ? TracedBy::kTraceRay : TracedBy::kRayQuery;
   for (const SetBinding& sb : use.bindings) {
-    if (b.pipeline->descriptor_buffers) {
-      out.push_back(Row(sb, TracedSource::kUnknown, by));
-      continue;
-    }
     const PushState pushed = sb.set < b.pushed_sets.size() ? b.pushed_sets[sb.set] : PushState::kNone;
-    if (pushed == PushState::kUnknown) {
+    if (b.pipeline->descriptor_buffers && pushed == PushState::kNone) {
+      out.push_back(BufferRow(b, sb, by));
+    } else if (pushed == PushState::kUnknown) {
       out.push_back(Row(sb, TracedSource::kUnknown, by));
     } else if (pushed == PushState::kKnown) {
       bool any = false;

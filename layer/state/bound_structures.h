@@ -32,7 +32,9 @@ class BoundStructures {
       b.sets.clear();
       b.pushed.clear();
       b.pushed_sets.clear();
+      b.buffer_sets.clear();
     }
+    descriptor_buffers_.clear();
   }
   void BindPipeline(Point point, std::shared_ptr<const PipelineStructureUse> pipeline) {
     bound_[point].pipeline = std::move(pipeline);
@@ -44,6 +46,13 @@ class BoundStructures {
   void PushUnknown(Point point, uint32_t set);
   // Starting a push at `set` replaces what was bound or pushed there before.
   void BeginPush(Point point, uint32_t set);
+  // vkCmdBindDescriptorBuffersEXT: the buffers' addresses by index (every bind point reads them).
+  void BindDescriptorBuffers(uint32_t count, const VkDescriptorBufferBindingInfoEXT* infos);
+  // vkCmdSetDescriptorBufferOffsetsEXT: set first_set + i reads buffer indices[i] at offsets[i], laid out as
+  // bindings[i] (the pipeline layout's set layout there; null: none with structures).
+  void SetBufferOffsets(Point point, uint32_t first_set, uint32_t count, const uint32_t* indices,
+                        const VkDeviceSize* offsets,
+                        const std::vector<std::shared_ptr<const RayBindings::BufferBindings>>& bindings);
   // vkCmdExecuteCommands: the bindings of the primary are undefined afterwards.
   void Forget() { Reset(); }
 
@@ -58,13 +67,25 @@ class BoundStructures {
     DescribedStructure structure;
   };
   enum class PushState : uint8_t { kNone, kKnown, kUnknown };
+  // A set read from a descriptor buffer (vkCmdSetDescriptorBufferOffsetsEXT).
+  struct BufferSet {
+    bool set = false;
+    uint32_t index = 0;
+    VkDeviceSize offset = 0;
+    std::shared_ptr<const RayBindings::BufferBindings> bindings;
+  };
   struct Bound {
     std::shared_ptr<const PipelineStructureUse> pipeline;
     std::vector<VkDescriptorSet> sets;  // by set number (VK_NULL_HANDLE: none)
     std::vector<Pushed> pushed;
     std::vector<PushState> pushed_sets;  // by set number
+    std::vector<BufferSet> buffer_sets;  // by set number
   };
+  // The row of a binding a descriptor-buffer pipeline reads.
+  TracedBinding BufferRow(const Bound& b, const SetBinding& sb, TracedBy by) const;
+
   std::array<Bound, kPointCount> bound_;
+  std::vector<VkDeviceAddress> descriptor_buffers_;  // by binding index (0: none)
 };
 
 }  // namespace asval

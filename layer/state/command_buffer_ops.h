@@ -211,7 +211,8 @@ enum class TracedSource : uint8_t {
   kSet,         // `set`, bound at set number set_index
   kPushed,      // `pushed` (with its serial), pushed with vkCmdPushDescriptorSetKHR
   kNotBound,    // nothing bound at that set number (or that binding was not pushed)
-  kUnknown,     // pushed with a template, or the pipeline reads descriptor buffers: not followed
+  kBuffer,      // read from descriptor bytes at descriptor_address (VK_EXT_descriptor_buffer), at submission
+  kUnknown,     // pushed with a template, or a descriptor-buffer layout the layer could not lay out: not followed
 };
 // The instruction that reads the binding, for the rule's VUID.
 enum class TracedBy : uint8_t { kTraceRay, kRayQuery };
@@ -220,9 +221,11 @@ struct TracedBinding {
   uint32_t binding;
   TracedSource source;
   TracedBy by;
+  uint32_t descriptor_count;  // kBuffer: the binding's descriptorCount
   VkDescriptorSet set;
   VkAccelerationStructureKHR pushed;
   uint64_t pushed_serial;  // AccelerationStructureState::serial when pushed (0: unknown)
+  VkDeviceAddress descriptor_address;  // kBuffer: the binding's first descriptor in the bound descriptor buffer
 };
 static_assert(std::is_trivial_v<TracedBinding>, "copied as bytes");
 

@@ -48,6 +48,15 @@ std::optional<HostMapping> HostMappings::Containing(uintptr_t address) const {
   return *mapping;
 }
 
+std::optional<HostMapping> HostMappings::OfMemory(VkDeviceMemory memory) const {
+  std::shared_lock lock(mutex_);
+  const auto begin = by_memory_.find(memory);
+  if (begin == by_memory_.end()) return std::nullopt;
+  const auto mapping = by_begin_.find(begin->second);
+  if (mapping == by_begin_.end()) return std::nullopt;
+  return mapping->second;
+}
+
 uintptr_t HostMappings::ContiguousEnd(uintptr_t address) const {
   std::shared_lock lock(mutex_);
   const HostMapping* mapping = ContainingLocked(address);

@@ -35,6 +35,8 @@ class HostMappings {
 
   // The mapping that contains `address`.
   std::optional<HostMapping> Containing(uintptr_t address) const;
+  // The mapping of `memory` (nullopt: not mapped).
+  std::optional<HostMapping> OfMemory(VkDeviceMemory memory) const;
   // The end of the run of mappings that starts with the one containing `address` and continues through
   // mappings that begin exactly where the previous one ends; 0 when no mapping contains `address`.
   uintptr_t ContiguousEnd(uintptr_t address) const;

@@ -2,13 +2,9 @@
 
 namespace asval {
 
-namespace {
-
-bool MayHoldStructures(VkDescriptorType type) {
+bool RayBindings::MayHoldStructures(VkDescriptorType type) {
   return type == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR || type == VK_DESCRIPTOR_TYPE_MUTABLE_EXT;
 }
-
-}  // namespace
 
 void RayBindings::AddModule(VkShaderModule module, const std::optional<ShaderStructureUse>& use) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -51,6 +47,72 @@ void RayBindings::ForgetLayout(VkDescriptorSetLayout layout) {
   if (idle()) return;
   std::lock_guard<std::mutex> lock(mutex_);
   layouts_.erase(layout);
+  buffer_layouts_.erase(layout);
+}
+
+void RayBindings::AddBufferLayout(VkDescriptorSetLayout layout, BufferBindings bindings) {
+  if (bindings.empty()) return;
+  auto shared = std::make_shared<const BufferBindings>(std::move(bindings));
+  std::lock_guard<std::mutex> lock(mutex_);
+  buffer_layouts_[layout] = std::move(shared);
+  Track();
+}
+
+void RayBindings::AddPipelineLayout(const VkPipelineLayoutCreateInfo& info, VkPipelineLayout layout) {
+  if (idle() || !info.pSetLayouts) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (buffer_layouts_.empty()) return;
+  std::vector<std::shared_ptr<const BufferBindings>> sets(info.setLayoutCount);
+  bool any = false;
+  for (uint32_t i = 0; i < info.setLayoutCount; ++i) {
+    const auto found = buffer_layouts_.find(info.pSetLayouts[i]);
+    if (found == buffer_layouts_.end()) continue;
+    sets[i] = found->second;
+    any = true;
+  }
+  if (any) pipeline_layouts_[layout] = std::move(sets);
+}
+
+void RayBindings::ForgetPipelineLayout(VkPipelineLayout layout) {
+  if (idle()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  pipeline_layouts_.erase(layout);
+}
+
+std::shared_ptr<const RayBindings::BufferBindings> RayBindings::BufferBindingsOf(VkPipelineLayout layout,
+                                                                                 uint32_t set) const {
+  if (idle()) return nullptr;
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto found = pipeline_layouts_.find(layout);
+  if (found == pipeline_layouts_.end() || set >= found->second.size()) return nullptr;
+  return found->second[set];
+}
+
+void RayBindings::AddStructureDescriptor(const void* bytes, std::size_t size, VkDeviceAddress address) {
+  if (!bytes || size == 0) return;
+  std::string key(static_cast<const char*>(bytes), size);
+  std::lock_guard<std::mutex> lock(mutex_);
+  descriptor_size_.store(size, std::memory_order_release);
+  const auto [it, inserted] = descriptors_.insert_or_assign(key, address);
+  if (!inserted) return;
+  // The oldest descriptor goes once the limit is reached (a ring over insertion order).
+  if (descriptor_order_.size() < kMaxDescriptors) {
+    descriptor_order_.push_back(std::move(key));
+  } else {
+    descriptors_.erase(descriptor_order_[descriptor_oldest_]);
+    descriptor_order_[descriptor_oldest_] = std::move(key);
+    descriptor_oldest_ = (descriptor_oldest_ + 1) % kMaxDescriptors;
+  }
+  Track();
+}
+
+bool RayBindings::StructureOfDescriptor(const void* bytes, std::size_t size, VkDeviceAddress* address) const {
+  const std::string key(static_cast<const char*>(bytes), size);
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto found = descriptors_.find(key);
+  if (found == descriptors_.end()) return false;
+  *address = found->second;
+  return true;
 }
 
 void RayBindings::AddTemplate(const VkDescriptorUpdateTemplateCreateInfo& info,

@@ -18,6 +18,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -87,6 +88,34 @@ class RayBindings {
   // Nothing to do for descriptor updates: no layout or template holds structures and no set does.
   bool idle() const { return !tracking_.load(std::memory_order_acquire); }
 
+  // A binding of this type may hold a structure descriptor (the structure type, or a mutable type).
+  static bool MayHoldStructures(VkDescriptorType type);
+
+  // ---- descriptor buffers (VK_EXT_descriptor_buffer) ----
+  // A descriptor-buffer set layout's structure bindings, each with where its descriptors start in a set's bytes
+  // (vkGetDescriptorSetLayoutBindingOffsetEXT, asked by the layer).
+  struct BufferBinding {
+    uint32_t binding;
+    uint32_t count;
+    VkDeviceSize offset;
+  };
+  using BufferBindings = std::vector<BufferBinding>;
+  void AddBufferLayout(VkDescriptorSetLayout layout, BufferBindings bindings);
+  // Kept only when one of its set layouts is a descriptor-buffer layout with structure bindings.
+  void AddPipelineLayout(const VkPipelineLayoutCreateInfo& info, VkPipelineLayout layout);
+  void ForgetPipelineLayout(VkPipelineLayout layout);
+  // The structure bindings of the descriptor-buffer set layout at `set` of a pipeline layout; null: none known.
+  std::shared_ptr<const BufferBindings> BufferBindingsOf(VkPipelineLayout layout, uint32_t set) const;
+  // vkGetDescriptorEXT of a structure: the descriptor's bytes, and the structure address they were made from (0: a
+  // null descriptor). The bytes are the key: what a shader reads from a descriptor buffer is turned back into an
+  // address. At most kMaxDescriptors are kept; past that the oldest are forgotten (then unknown, counted).
+  static constexpr std::size_t kMaxDescriptors = 1u << 16;
+  void AddStructureDescriptor(const void* bytes, std::size_t size, VkDeviceAddress address);
+  // The address the bytes were made from; false when no vkGetDescriptorEXT the layer saw made them.
+  bool StructureOfDescriptor(const void* bytes, std::size_t size, VkDeviceAddress* address) const;
+  // The size of a structure descriptor (the dataSize of vkGetDescriptorEXT; 0 before any).
+  std::size_t structure_descriptor_size() const { return descriptor_size_.load(std::memory_order_acquire); }
+
   // The structures in `set`'s `binding`, each passed to f(const DescribedStructure&).
   template <typename F>
   SetLookup ForEachIn(VkDescriptorSet set, uint32_t binding, F&& f) const;
@@ -128,6 +157,12 @@ class RayBindings {
   std::unordered_map<VkDescriptorSetLayout, std::shared_ptr<const StructureBindings>> layouts_;  // only those with any
   std::unordered_map<VkDescriptorUpdateTemplate, std::vector<TemplateEntry>> templates_;  // only those with structures
   std::unordered_map<VkDescriptorSet, SetRecord> sets_;
+  std::unordered_map<VkDescriptorSetLayout, std::shared_ptr<const BufferBindings>> buffer_layouts_;
+  std::unordered_map<VkPipelineLayout, std::vector<std::shared_ptr<const BufferBindings>>> pipeline_layouts_;
+  std::unordered_map<std::string, VkDeviceAddress> descriptors_;  // descriptor bytes -> structure address
+  std::vector<std::string> descriptor_order_;                     // insertion order, for forgetting the oldest
+  std::size_t descriptor_oldest_ = 0;
+  std::atomic<std::size_t> descriptor_size_{0};
   std::atomic<bool> tracking_{false};
 };
 

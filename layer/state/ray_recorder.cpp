@@ -175,8 +175,33 @@ void RecordDestroyPipeline(DeviceState& state, VkPipeline pipeline) {
 }
 
 void RecordCreateDescriptorSetLayout(DeviceState& state, const VkDescriptorSetLayoutCreateInfo& info,
-                                     VkDescriptorSetLayout layout) {
-  if (state.traces_tracked) Guarded(state, [&] { state.ray_bindings.AddLayout(info, layout); });
+                                     VkDescriptorSetLayout layout,
+                                     const std::function<VkDeviceSize(uint32_t binding)>& offset_of) {
+  if (!state.traces_tracked) return;
+  Guarded(state, [&] {
+    state.ray_bindings.AddLayout(info, layout);
+    if (!(info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_DESCRIPTOR_BUFFER_BIT_EXT) || !offset_of) return;
+    RayBindings::BufferBindings bindings;
+    for (uint32_t i = 0; info.pBindings && i < info.bindingCount; ++i) {
+      const VkDescriptorSetLayoutBinding& b = info.pBindings[i];
+      if (!RayBindings::MayHoldStructures(b.descriptorType)) continue;
+      bindings.push_back(RayBindings::BufferBinding{b.binding, b.descriptorCount, offset_of(b.binding)});
+    }
+    state.ray_bindings.AddBufferLayout(layout, std::move(bindings));
+  });
+}
+
+void RecordCreatePipelineLayout(DeviceState& state, const VkPipelineLayoutCreateInfo& info, VkPipelineLayout layout) {
+  if (state.traces_tracked) Guarded(state, [&] { state.ray_bindings.AddPipelineLayout(info, layout); });
+}
+
+void RecordDestroyPipelineLayout(DeviceState& state, VkPipelineLayout layout) {
+  if (state.traces_tracked && layout != VK_NULL_HANDLE) state.ray_bindings.ForgetPipelineLayout(layout);
+}
+
+void RecordGetDescriptor(DeviceState& state, const VkDescriptorGetInfoEXT& info, std::size_t size, const void* bytes) {
+  if (!state.traces_tracked || info.type != VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) return;
+  Guarded(state, [&] { state.ray_bindings.AddStructureDescriptor(bytes, size, info.data.accelerationStructure); });
 }
 
 void RecordDestroyDescriptorSetLayout(DeviceState& state, VkDescriptorSetLayout layout) {
@@ -272,6 +297,27 @@ void RecordPushDescriptorSetWithTemplate(DeviceState& state, VkCommandBuffer cb,
       }
     });
   }
+}
+
+void RecordBindDescriptorBuffers(DeviceState& state, VkCommandBuffer cb, uint32_t count,
+                                 const VkDescriptorBufferBindingInfoEXT* infos) {
+  if (CommandBufferState* recording = Following(state, cb)) {
+    Guarded(state, [&] { recording->bound_structures.BindDescriptorBuffers(count, infos); });
+  }
+}
+
+void RecordSetDescriptorBufferOffsets(DeviceState& state, VkCommandBuffer cb, VkPipelineBindPoint bind_point,
+                                      VkPipelineLayout layout, uint32_t first_set, uint32_t count,
+                                      const uint32_t* indices, const VkDeviceSize* offsets) {
+  const BoundStructures::Point point = BoundStructures::PointOf(bind_point);
+  if (point == BoundStructures::kPointCount) return;
+  CommandBufferState* recording = Following(state, cb);
+  if (!recording) return;
+  Guarded(state, [&] {
+    std::vector<std::shared_ptr<const RayBindings::BufferBindings>> bindings(count);
+    for (uint32_t i = 0; i < count; ++i) bindings[i] = state.ray_bindings.BufferBindingsOf(layout, first_set + i);
+    recording->bound_structures.SetBufferOffsets(point, first_set, count, indices, offsets, bindings);
+  });
 }
 
 void RecordExecuteForTraces(DeviceState& state, VkCommandBuffer primary) {

@@ -334,6 +334,12 @@ Tlas::~Tlas() {
   device_.Destroy(scratch_);
 }
 
+VkDeviceAddress Tlas::address() const {
+  VkAccelerationStructureDeviceAddressInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+  info.accelerationStructure = as_.handle;
+  return device_.GetAccelerationStructureDeviceAddressKHR(device_.handle(), &info);
+}
+
 void Tlas::DestroyHandle() {
   if (as_.handle) device_.DestroyAccelerationStructureKHR(device_.handle(), as_.handle, nullptr);
   as_.handle = VK_NULL_HANDLE;

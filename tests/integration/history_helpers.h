@@ -198,6 +198,8 @@ class Tlas {
   // The info Record would record, for a call of several infos (RecordBuilds).
   BuildInfo Info(const vkkit::Buffer& instances, uint32_t count, VkBuildAccelerationStructureModeKHR mode) const;
   VkAccelerationStructureKHR handle() const { return as_.handle; }
+  // The structure's device address (vkGetAccelerationStructureDeviceAddressKHR).
+  VkDeviceAddress address() const;
   // Destroys the structure, not its storage (lifetime tests).
   void DestroyHandle();
   // Destroys the VkBuffer of its storage, not the structure nor the memory; or frees the memory, not the buffer

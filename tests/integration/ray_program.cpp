@@ -307,3 +307,96 @@ void RayProgram::MakeRayTracingPipeline() {
 }
 
 }  // namespace asval_test
+
+namespace asval_test {
+
+vkkit::DeviceOptions RayDescriptorBufferDevice() {
+  static VkPhysicalDeviceDescriptorBufferFeaturesEXT buffers{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DESCRIPTOR_BUFFER_FEATURES_EXT};
+  buffers.descriptorBuffer = VK_TRUE;
+  vkkit::DeviceOptions options = RayDevice();
+  buffers.pNext = options.features;
+  options.features = &buffers;
+  options.extensions.push_back(VK_EXT_DESCRIPTOR_BUFFER_EXTENSION_NAME);
+  return options;
+}
+
+DescriptorBufferRayQuery::DescriptorBufferRayQuery(vkkit::Device& device) : device_(device) {
+  const VkDevice d = device.handle();
+  VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &properties_};
+  vkGetPhysicalDeviceProperties2(device.physical_device(), &properties);
+  const VkDescriptorSetLayoutBinding bindings[2] = {
+      {0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+  VkDescriptorSetLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  layout_info.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_DESCRIPTOR_BUFFER_BIT_EXT;
+  layout_info.bindingCount = 2;
+  layout_info.pBindings = bindings;
+  vkkit::Check(vkCreateDescriptorSetLayout(d, &layout_info, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  const auto offset_of =
+      Proc<PFN_vkGetDescriptorSetLayoutBindingOffsetEXT>(device, "vkGetDescriptorSetLayoutBindingOffsetEXT");
+  const auto size_of = Proc<PFN_vkGetDescriptorSetLayoutSizeEXT>(device, "vkGetDescriptorSetLayoutSizeEXT");
+  offset_of(d, set_layout_, 0, &structure_offset_);
+  offset_of(d, set_layout_, 1, &output_offset_);
+  VkDeviceSize layout_size = 0;
+  size_of(d, set_layout_, &layout_size);
+  VkPipelineLayoutCreateInfo pipeline_layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pipeline_layout_info.setLayoutCount = 1;
+  pipeline_layout_info.pSetLayouts = &set_layout_;
+  vkkit::Check(vkCreatePipelineLayout(d, &pipeline_layout_info, nullptr, &layout_), "vkCreatePipelineLayout");
+  descriptors_ = device.CreateBuffer(layout_size, VK_BUFFER_USAGE_RESOURCE_DESCRIPTOR_BUFFER_BIT_EXT);
+  output_ = device.CreateBuffer(256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  const VkShaderModule module = MakeModule(d, kRayQueryComp, sizeof(kRayQueryComp));
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.flags = VK_PIPELINE_CREATE_DESCRIPTOR_BUFFER_BIT_EXT;
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.layout = layout_;
+  vkkit::Check(vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_), "vkCreateComputePipelines");
+  vkDestroyShaderModule(d, module, nullptr);
+}
+
+DescriptorBufferRayQuery::~DescriptorBufferRayQuery() {
+  const VkDevice d = device_.handle();
+  vkDestroyPipeline(d, pipeline_, nullptr);
+  vkDestroyPipelineLayout(d, layout_, nullptr);
+  vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+  device_.Destroy(descriptors_);
+  device_.Destroy(output_);
+}
+
+void DescriptorBufferRayQuery::Write(VkDeviceAddress address) {
+  const auto get = Proc<PFN_vkGetDescriptorEXT>(device_, "vkGetDescriptorEXT");
+  auto* bytes = static_cast<unsigned char*>(descriptors_.mapped);
+  VkDescriptorGetInfoEXT info{VK_STRUCTURE_TYPE_DESCRIPTOR_GET_INFO_EXT};
+  info.type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+  info.data.accelerationStructure = address;
+  get(device_.handle(), &info, properties_.accelerationStructureDescriptorSize, bytes + structure_offset_);
+  const VkDescriptorAddressInfoEXT output{VK_STRUCTURE_TYPE_DESCRIPTOR_ADDRESS_INFO_EXT, nullptr, output_.address,
+                                          output_.size, VK_FORMAT_UNDEFINED};
+  info.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  info.data.pStorageBuffer = &output;
+  get(device_.handle(), &info, properties_.storageBufferDescriptorSize, bytes + output_offset_);
+}
+
+void DescriptorBufferRayQuery::Scribble(unsigned char value) {
+  std::memset(static_cast<unsigned char*>(descriptors_.mapped) + structure_offset_, value,
+              properties_.accelerationStructureDescriptorSize);
+}
+
+void DescriptorBufferRayQuery::Record(VkCommandBuffer cb) {
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  VkDescriptorBufferBindingInfoEXT binding{VK_STRUCTURE_TYPE_DESCRIPTOR_BUFFER_BINDING_INFO_EXT};
+  binding.address = descriptors_.address;
+  binding.usage = VK_BUFFER_USAGE_RESOURCE_DESCRIPTOR_BUFFER_BIT_EXT;
+  Proc<PFN_vkCmdBindDescriptorBuffersEXT>(device_, "vkCmdBindDescriptorBuffersEXT")(cb, 1, &binding);
+  const uint32_t index = 0;
+  const VkDeviceSize offset = 0;
+  Proc<PFN_vkCmdSetDescriptorBufferOffsetsEXT>(device_, "vkCmdSetDescriptorBufferOffsetsEXT")(
+      cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &index, &offset);
+  vkCmdDispatch(cb, 1, 1, 1);
+}
+
+}  // namespace asval_test

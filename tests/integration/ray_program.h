@@ -64,6 +64,41 @@ class RayProgram {
   VkStridedDeviceAddressRegionKHR raygen_{}, miss_{};
 };
 
+// A device as RayDevice() with VK_EXT_descriptor_buffer (descriptorBuffer), for DescriptorBufferRayQuery.
+vkkit::DeviceOptions RayDescriptorBufferDevice();
+
+// The ray-query compute pipeline of RayProgram (ray_query.comp), reading its descriptors from a host-visible
+// descriptor buffer (VK_EXT_descriptor_buffer): set 0 at offset 0 of the one buffer bound, binding 0 the structure
+// (written with vkGetDescriptorEXT from its address), binding 1 the output buffer.
+class DescriptorBufferRayQuery {
+ public:
+  explicit DescriptorBufferRayQuery(vkkit::Device& device);
+  ~DescriptorBufferRayQuery();
+  DescriptorBufferRayQuery(const DescriptorBufferRayQuery&) = delete;
+  DescriptorBufferRayQuery& operator=(const DescriptorBufferRayQuery&) = delete;
+
+  // Writes the descriptor of the structure at `address` (0: a null descriptor) into binding 0, and the output
+  // buffer's into binding 1.
+  void Write(VkDeviceAddress address);
+  // Writes `value` into every byte of binding 0's descriptor (bytes no vkGetDescriptorEXT made).
+  void Scribble(unsigned char value);
+  // Binds the pipeline and the descriptor buffer, sets set 0's offset, and dispatches one ray.
+  void Record(VkCommandBuffer cb);
+  uint32_t hit() const { return *static_cast<const uint32_t*>(output_.mapped); }
+  void Clear() { *static_cast<uint32_t*>(output_.mapped) = 7; }
+
+ private:
+  vkkit::Device& device_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  vkkit::Buffer descriptors_;
+  vkkit::Buffer output_;
+  VkDeviceSize structure_offset_ = 0, output_offset_ = 0;
+  VkPhysicalDeviceDescriptorBufferPropertiesEXT properties_{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DESCRIPTOR_BUFFER_PROPERTIES_EXT};
+};
+
 // A bottom-level structure of one triangle under the ray and a top-level structure with one instance of it.
 struct RayScene {
   explicit RayScene(vkkit::Device& d)
