@@ -44,6 +44,15 @@ Procs::Procs(vkkit::Device& device) {
   QueueSubmit2 = Load<PFN_vkQueueSubmit2>(device, "vkQueueSubmit2");
 }
 
+VkResult Procs::Submit2(VkQueue queue, VkCommandBuffer cb) const {
+  VkCommandBufferSubmitInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cb_info.commandBuffer = cb;
+  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  submit.commandBufferInfoCount = 1;
+  submit.pCommandBufferInfos = &cb_info;
+  return QueueSubmit2(queue, 1, &submit, VK_NULL_HANDLE);
+}
+
 // ---- Commands --------------------------------------------------------------------------------------------------
 
 Commands::Commands(vkkit::Device& device) : device_(device) {

@@ -44,6 +44,8 @@ struct Procs {
   PFN_vkWriteAccelerationStructuresPropertiesKHR HostWriteProperties = nullptr;
   PFN_vkCmdExecuteCommands CmdExecuteCommands = nullptr;
   PFN_vkQueueSubmit2 QueueSubmit2 = nullptr;
+  // One vkQueueSubmit2 of `cb` alone, no fence, not waited for (QueueSubmit2 must be loaded).
+  VkResult Submit2(VkQueue queue, VkCommandBuffer cb) const;
 };
 
 // Command buffers from one pool, recorded whenever and submitted in any order; all freed at the end.

@@ -76,13 +76,8 @@ TEST_CASE(
   procs.CmdExecuteCommands(primary, 1, &secondary);
   commands.End(primary);
   blas.DestroyHandle();
-  VkCommandBufferSubmitInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-  cb_info.commandBuffer = primary;
-  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-  submit.commandBufferInfoCount = 1;
-  submit.pCommandBufferInfos = &cb_info;
   f.monitor().Expect(kSubmit2Invalid);
-  CHECK(procs.QueueSubmit2(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(procs.Submit2(device.queue(), primary) == VK_ERROR_VALIDATION_FAILED_EXT);
   CHECK(f.monitor().Verify() == "");
 }
 
