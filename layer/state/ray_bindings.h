@@ -109,7 +109,7 @@ class RayBindings {
   // vkGetDescriptorEXT of a structure: the descriptor's bytes, and the structure address they were made from (0: a
   // null descriptor). The bytes are the key: what a shader reads from a descriptor buffer is turned back into an
   // address. At most kMaxDescriptors are kept; past that the oldest are forgotten (then unknown, counted).
-  static constexpr std::size_t kMaxDescriptors = 1u << 16;
+  static constexpr std::size_t kMaxDescriptors = 1u << 12;
   void AddStructureDescriptor(const void* bytes, std::size_t size, VkDeviceAddress address);
   // The address the bytes were made from; false when no vkGetDescriptorEXT the layer saw made them.
   bool StructureOfDescriptor(const void* bytes, std::size_t size, VkDeviceAddress* address) const;
