@@ -46,7 +46,8 @@ void BoundStructures::SetBufferOffsets(
   Bound& b = bound_[point];
   for (uint32_t i = 0; indices && offsets && i < count; ++i) {
     const uint32_t set = first_set + i;
-    At(b.buffer_sets, set) = BufferSet{true, indices[i], offsets[i], i < bindings.size() ? bindings[i] : nullptr};
+    const VkDeviceAddress base = indices[i] < descriptor_buffers_.size() ? descriptor_buffers_[indices[i]] : 0;
+    At(b.buffer_sets, set) = BufferSet{true, indices[i], offsets[i], base, i < bindings.size() ? bindings[i] : nullptr};
     if (set < b.sets.size()) b.sets[set] = VK_NULL_HANDLE;
     if (set < b.pushed_sets.size()) b.pushed_sets[set] = PushState::kNone;
   }
@@ -89,8 +90,9 @@ TracedBinding BoundStructures::BufferRow(const Bound& b, const SetBinding& sb, T
   if (!set || set->index >= descriptor_buffers_.size() || descriptor_buffers_[set->index] == 0) {
     return Row(sb, TracedSource::kNotBound, by);
   }
-  // The layout's structure bindings were not known (its offsets could not be asked): the descriptors are not read.
-  if (!set->bindings) return Row(sb, TracedSource::kUnknown, by);
+  // The layout's structure bindings were not known (its offsets could not be asked), or another buffer was bound at
+  // that index after the offset was set: the descriptors are not read.
+  if (!set->bindings || set->base != descriptor_buffers_[set->index]) return Row(sb, TracedSource::kUnknown, by);
   for (const RayBindings::BufferBinding& binding : *set->bindings) {
     if (binding.binding != sb.binding) continue;
     TracedBinding row = Row(sb, TracedSource::kBuffer, by);

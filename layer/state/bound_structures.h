@@ -72,6 +72,9 @@ class BoundStructures {
     bool set = false;
     uint32_t index = 0;
     VkDeviceSize offset = 0;
+    // The address bound at `index` when the offset was set: a buffer bound there since makes the set's address one
+    // the layer does not assume (read then, or at the command), so the binding is not read.
+    VkDeviceAddress base = 0;
     std::shared_ptr<const RayBindings::BufferBindings> bindings;
   };
   struct Bound {
