@@ -28,11 +28,13 @@ struct RecordedJudge {
     return f && std::strncmp(f, "vkQueueSubmit2", 14) == 0 ? kSubmit2Invalid : kSubmitInvalid;
   }
 
-  // One finding per submitted command buffer and object: a command buffer of many builds over one destroyed
-  // scratch buffer is reported once.
+  // One finding of this rule per submitted command buffer and object: a command buffer of many builds over one
+  // destroyed scratch buffer is reported once (another rule's finding about the same object is not this one).
   bool Reported(uint64_t object) const {
+    const char* vuid = Vuid();
     for (const HistoryFinding& f : out.list()) {
-      if (f.objects[0].handle == reinterpret_cast<uint64_t>(site.submitted) && f.objects[1].handle == object) {
+      if (f.vuid == vuid && f.objects[0].handle == reinterpret_cast<uint64_t>(site.submitted) &&
+          f.objects[1].handle == object) {
         return true;
       }
     }
