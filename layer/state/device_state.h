@@ -139,6 +139,9 @@ class DeviceState {
   // The newest id given so far: an object created, bound or destroyed after this read gets a larger one. A command
   // records it (OpOrigin::recorded_at) without taking an id (a load, not a read-modify-write, per recorded command).
   uint64_t LastObjectId() const { return next_object_id_.load(std::memory_order_relaxed); }
+  // The newest structure's serial (AccelerationStructureState::serial; 0: none yet): a command recorded at or after
+  // it names no structure created since (history_apply.cpp: a handle reused after the recording).
+  std::atomic<uint64_t> last_structure_created{0};
 
  private:
   std::atomic<uint64_t> next_object_id_{0};

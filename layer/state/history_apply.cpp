@@ -443,12 +443,14 @@ void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn)
   store.SetSlot(op.query_pool, op.query, QuerySlot{op.dst, h ? h->generation : 0, op.query_type}, txn);
 }
 
-// A device command recorded before a structure it names was destroyed, whose handle now names a structure created
-// after the recording: the command buffer is invalid (reported by layer/checks/recorded_objects.h), and what the
-// command does with the stale handle is not defined. Destroys are rare: two loads while none followed the recording.
+// A device command whose handle now names a structure created after the recording (the one it named was destroyed,
+// or it named none): the command buffer is invalid (reported by layer/checks/recorded_objects.h, or by the Khronos
+// layer), and what the command does with the stale handle is not defined. One load while no structure was created
+// after the recording.
 bool NamesReplacedStructure(const DeviceState& state, const AsOp& op) {
   const uint64_t recorded_at = op.origin.recorded_at;
-  if (recorded_at == 0 || op.kind == OpKind::kTrace || state.destroyed.last_structure_destroyed() <= recorded_at) {
+  if (recorded_at == 0 || op.kind == OpKind::kTrace ||
+      state.last_structure_created.load(std::memory_order_acquire) <= recorded_at) {
     return false;
   }
   const auto replaced = [&](VkAccelerationStructureKHR as) {
@@ -469,8 +471,7 @@ void ApplyOnReplaced(const DeviceState& state, HistoryStore& store, const AsOp& 
       if (std::optional<Written> fresh = Fresh(state, store, op.dst)) {
         fresh->history.kind = HistoryKind::kUnknown;
         fresh->history.unknown_reason = UnknownReason::kStaleHandle;
-        store.Set(op.dst, std::move(fresh->history), txn);
-        store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+        SetWritten(store, op.dst, *fresh, op, txn);  // what else lies in its memory is clobbered, as by any write
       }
       return;
     case OpKind::kWriteProperties:

@@ -266,6 +266,10 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   auto record = std::make_shared<AccelerationStructureState>();
   record->handle = handle;
   record->serial = state.NextObjectId();
+  for (uint64_t newest = state.last_structure_created.load(std::memory_order_relaxed);
+       newest < record->serial &&
+       !state.last_structure_created.compare_exchange_weak(newest, record->serial, std::memory_order_release);) {
+  }
   record->buffer = info.buffer;
   record->offset = info.offset;
   record->size = info.size;

@@ -280,6 +280,12 @@ class Harness {
     const uint32_t i = Recording(r);
     const VkCommandBuffer cb = CommandBuffer(i);
     CommandBufferModel& m = cbs_[i];
+    const std::size_t first = m.ops.size();
+    RecordDeviceOp(r, cb, m);
+    for (std::size_t k = first; k < m.ops.size(); ++k) m.ops[k].recorded_at = model_.clock;
+  }
+
+  void RecordDeviceOp(Reader& r, VkCommandBuffer cb, CommandBufferModel& m) {
     switch (r.Below(6)) {
       case 0:
       case 1: {

@@ -42,8 +42,7 @@ struct ModelParams {
 enum class ModelKind { kNeverBuilt, kBuilt, kUnknown };
 enum class ModelUnknown { kNone, kDeserializedUnknownBytes, kDeserializedDeviceBytes, kCopiedFromUnknown,
                           kLostOperations, kUnreadableBuild,
-                          kStaleHandle };  // never made by the model: its operations are host calls or
-                                           // recorded after every structure they name was created
+                          kStaleHandle };  // a device command recorded before its structure's handle was reused
 
 struct ModelHistory {
   ModelKind kind = ModelKind::kNeverBuilt;
@@ -70,6 +69,9 @@ struct ModelOp {
   uint32_t blob = 0;             // host serialization: which host array
   uint32_t pool_query = 0;       // kWriteProperties: the slot
   VkQueryType query_type = VK_QUERY_TYPE_OCCLUSION;
+  // Model::clock when a device command recorded it (0: a host call): a structure created later under one of its
+  // handles is not the one it named (its command buffer is invalid; what it does there is unknown).
+  uint64_t recorded_at = 0;
 };
 
 struct ModelBlob {
@@ -90,6 +92,7 @@ struct ModelSlot {
 
 struct ModelStructure {
   bool live = false;
+  uint64_t created = 0;  // Model::clock at its creation
   uint64_t begin = 0, end = 0;  // its VkDeviceMemory bytes
   ModelHistory history;
 };
@@ -100,6 +103,7 @@ struct Model {
   std::vector<ModelBlob> blobs;
   std::map<uint32_t, ModelSlot> slots;
   uint64_t next_contents = 0;
+  uint64_t clock = 1;  // counts creations (a device command's recorded_at is never 0)
   uint32_t next_blob = 0;
   // During a submission (undoable): what it added or invalidated, and the structures host operations completing
   // meanwhile changed (those keep their newer history when the submission is undone).
@@ -197,8 +201,39 @@ struct Model {
     blobs.push_back(std::move(blob));
   }
 
+  // A structure created under handle `as` after `op` was recorded.
+  bool Replaced(const ModelOp& op, uint32_t as) const {
+    return op.recorded_at != 0 && structures[as].live && structures[as].created > op.recorded_at;
+  }
+  // The handles an operation names: its source (update, copy, serialization) and destination.
+  bool NamesReplaced(const ModelOp& op) const {
+    const bool has_src = (op.kind == ModelOp::kBuild && op.update) || op.kind == ModelOp::kCopy ||
+                         op.kind == ModelOp::kSerializeDevice || op.kind == ModelOp::kSerializeHost;
+    const bool has_dst = op.kind != ModelOp::kSerializeDevice && op.kind != ModelOp::kSerializeHost;
+    return (has_src && Replaced(op, op.src)) || (has_dst && Replaced(op, op.dst));
+  }
+  void ApplyReplaced(const ModelOp& op) {
+    switch (op.kind) {
+      case ModelOp::kSerializeDevice:
+      case ModelOp::kSerializeHost:
+        for (ModelBlob& b : blobs) Invalidate(b);
+        return;
+      case ModelOp::kWriteProperties:
+        slots[op.pool_query] = ModelSlot{op.dst, 0, op.query_type};
+        return;
+      default:
+        if (!structures[op.dst].live) return;
+        ModelHistory h;
+        h.kind = ModelKind::kUnknown;
+        h.reason = ModelUnknown::kStaleHandle;
+        Write(op.dst, std::move(h));
+        return;
+    }
+  }
+
   // Applies one operation in execution order. host_bytes: the host arrays as they are now.
   void Apply(const ModelOp& op, const std::vector<uint8_t> (&host_bytes)[kHostBlobs]) {
+    if (NamesReplaced(op)) return ApplyReplaced(op);
     switch (op.kind) {
       case ModelOp::kBuild: {
         if (!structures[op.dst].live) return;  // destroyed before it executed: nothing to record
@@ -333,6 +368,7 @@ struct Model {
   void Create(uint32_t as, uint64_t begin, uint64_t end) {
     structures[as] = ModelStructure{};
     structures[as].live = true;
+    structures[as].created = ++clock;
     structures[as].begin = begin;
     structures[as].end = end;
   }
