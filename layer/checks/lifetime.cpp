@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "buffer_lookup.h"
 #include "structure_memory.h"
 
 namespace asval {
@@ -31,18 +32,6 @@ std::shared_ptr<const AccelerationStructureState> StructureOf(const CheckContext
   std::optional<std::shared_ptr<const AccelerationStructureState>> record = ctx.state.acceleration_structures.find(as);
   if (!record || !*record || (*record)->serial > submitted) return nullptr;
   return *record;
-}
-
-// The live buffers holding `address` that were bound before the submission `submitted`: calls hold(BufferState).
-template <typename Hold>
-void ForEachHolder(const CheckContext& ctx, VkDeviceAddress address, uint64_t submitted, Hold&& hold) {
-  AddressHits hits;
-  ctx.state.buffer_addresses.FindContaining(address, hits);
-  for (const AddressHit& hit : hits) {
-    std::optional<std::shared_ptr<const BufferState>> b = ctx.state.buffers.find(hit.buffer);
-    if (!b || !*b || !(*b)->bound || (*b)->memory_freed || (*b)->bound_serial > submitted) continue;
-    hold(**b);
-  }
 }
 
 // Where an operation of a batch came from, for the message.
@@ -183,8 +172,9 @@ FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, const Going& 
     for (const AddressTouch& touch : recorded->batch.touches()) {
       if (!going_away.Touches(touch.address)) continue;
       bool going = false, staying = false;
-      ForEachHolder(ctx, touch.address, b.serial,
-                    [&](const BufferState& holder) { (goes(holder) ? going : staying) = true; });
+      ForEachBufferHolding(ctx.state, touch.address, b.serial, [&](const BufferState& holder) {
+        if (!holder.memory_freed) (goes(holder) ? going : staying) = true;
+      });
       if (going && !staying && touch.op < ops.size()) {
         found.op = &ops[touch.op];
         found.how = fmt::format("its {} (0x{:x})", TouchRoleName(touch.role), touch.address);
@@ -252,8 +242,9 @@ bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDevice
                               what, reinterpret_cast<uint64_t>(kept), kNotDone));
   }
   Going going;
-  for (const auto& [handle, b] : ctx.state.buffers.snapshot(
-           [&](VkBuffer, const std::shared_ptr<const BufferState>& s) { return s && s->bound && s->memory == memory; })) {
+  for (const auto& [handle, b] : ctx.state.buffers.snapshot([&](VkBuffer, const std::shared_ptr<const BufferState>& s) {
+         return s && s->bound && s->memory == memory;
+       })) {
     going.Add(ctx, *b);
   }
   return CheckInUse(ctx, in_flight, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),

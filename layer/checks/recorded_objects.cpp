@@ -6,7 +6,7 @@
 #include <cstring>
 #include <string>
 
-#include "address_map.h"
+#include "buffer_lookup.h"
 #include "build_report.h"
 
 namespace asval {
@@ -41,7 +41,7 @@ struct RecordedJudge {
     return false;
   }
 
-  DestroyedObjects::Between Between() const {
+  ObjectLifetimes::Between Between() const {
     return {op.origin.recorded_at, site.submitted_at != 0 ? site.submitted_at : ~uint64_t{0}};
   }
 
@@ -51,13 +51,13 @@ struct RecordedJudge {
     if (!as) return;
     const std::optional<std::shared_ptr<const AccelerationStructureState>> now = state.acceleration_structures.find(as);
     if (now && *now && (*now)->serial <= op.origin.recorded_at) return;  // the structure recorded still lives
-    DestroyedObjects::Structure gone{};
-    switch (state.destroyed.StructureDestroyedSince(as, Between(), &gone)) {
-      case DestroyedObjects::Answer::kNo:
+    ObjectLifetimes::Structure gone{};
+    switch (state.lifetimes.StructureDestroyedSince(as, Between(), &gone)) {
+      case ObjectLifetimes::Answer::kNo:
         return;  // the handle named no structure when recorded: another rule's
-      case DestroyedObjects::Answer::kUnknown:
+      case ObjectLifetimes::Answer::kUnknown:
         return Forgotten();
-      case DestroyedObjects::Answer::kYes:
+      case ObjectLifetimes::Answer::kYes:
         break;
     }
     state.lifetime_counters.recorded_judged.fetch_add(1, std::memory_order_relaxed);
@@ -68,19 +68,16 @@ struct RecordedJudge {
   void Address(const AddressTouch& touch) const {
     if (touch.address == 0) return;
     // Still in a live buffer bound when the command was recorded (an alias over the same memory stays): valid.
-    AddressHits hits;
-    state.buffer_addresses.FindContaining(touch.address, hits);
-    for (const AddressHit& hit : hits) {
-      const std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(hit.buffer);
-      if (b && *b && (*b)->bound && (*b)->bound_serial <= op.origin.recorded_at) return;
-    }
-    DestroyedObjects::Buffer gone{};
-    switch (state.destroyed.BufferDestroyedSince(touch.address, Between(), &gone)) {
-      case DestroyedObjects::Answer::kNo:
+    bool held = false;
+    ForEachBufferHolding(state, touch.address, op.origin.recorded_at, [&](const BufferState&) { held = true; });
+    if (held) return;
+    ObjectLifetimes::Buffer gone{};
+    switch (state.lifetimes.BufferDestroyedSince(touch.address, Between(), &gone)) {
+      case ObjectLifetimes::Answer::kNo:
         return;  // in no buffer when recorded: the address rules' business
-      case DestroyedObjects::Answer::kUnknown:
+      case ObjectLifetimes::Answer::kUnknown:
         return Forgotten();
-      case DestroyedObjects::Answer::kYes:
+      case ObjectLifetimes::Answer::kYes:
         break;
     }
     state.lifetime_counters.recorded_judged.fetch_add(1, std::memory_order_relaxed);
@@ -100,8 +97,7 @@ struct RecordedJudge {
                         handle_reused ? " (the handle now names another structure, created after the recording)" : ""));
   }
 
-  [[gnu::cold, gnu::noinline]] void ReportBuffer(const AddressTouch& touch,
-                                                 const DestroyedObjects::Buffer& gone) const {
+  [[gnu::cold, gnu::noinline]] void ReportBuffer(const AddressTouch& touch, const ObjectLifetimes::Buffer& gone) const {
     out.Add(
         Severity::kError, Vuid(), site.loc,
         {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(VK_OBJECT_TYPE_BUFFER, gone.handle), ReportObject{}},
@@ -136,11 +132,11 @@ void CheckRecordedObjects(const DeviceState& state, const OpBatch& batch, const 
   const uint64_t recorded_at = op.origin.recorded_at;
   if (recorded_at == 0 || op.kind == OpKind::kTrace) return;  // host calls; traces are family traces'
   const RecordedJudge judge{state, batch, op, site, out};
-  if (state.destroyed.last_structure_destroyed() > recorded_at) {
+  if (state.lifetimes.last_structure_destroyed() > recorded_at) {
     judge.Structure(op.src, SourceRole(op));
     judge.Structure(op.dst, DestinationRole(op));
   }
-  if (state.destroyed.last_buffer_destroyed() > recorded_at) {
+  if (state.lifetimes.last_buffer_destroyed() > recorded_at) {
     // The batch's touches are in operation order (OpBatch appends them so).
     const uint32_t index = static_cast<uint32_t>(&op - batch.ops().data());
     const AddressTouch* first = std::lower_bound(batch.touches().begin(), batch.touches().end(), index,

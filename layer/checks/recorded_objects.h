@@ -8,10 +8,10 @@
 // Recorded objects: the structures a command names by handle (source and destination of builds, updates, copies,
 // serializations and deserializations, the structures a property query reads), and the buffers holding the addresses
 // it reads or writes (scratch, geometry inputs, instances, serialized bytes; OpBatch::touches). Handles and addresses
-// are reused, so each is judged by serials (OpOrigin::recorded_at against DestroyedObjects): reported only when the
+// are reused, so each is judged by serials (OpOrigin::recorded_at against ObjectLifetimes): reported only when the
 // structure that lived under the handle when the command was recorded, or every buffer bound then holding the
 // address, was destroyed after the recording. A handle or address that named nothing then is another rule's.
-// Destroys older than the layer's memory of them (DestroyedObjects' ring) are skipped and counted
+// Destroys older than the layer's memory of them (ObjectLifetimes' ring) are skipped and counted
 // (recorded_forgotten in ASVAL-Lifetime-Summary). Trace and dispatch bindings are not judged here (family traces
 // counts a destroyed binding).
 //

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "address_map.h"
+#include "buffer_lookup.h"
 #include "build_report.h"
 #include "structure_memory.h"
 
@@ -46,7 +46,7 @@ struct TracedJudge {
     if (size == 0) return Skip(TracedSkip::kUnreadable);  // no structure descriptor was made through the layer
     std::shared_ptr<const LiveStructureAddresses> live;
     for (uint32_t i = 0; i < b.descriptor_count; ++i) {
-      const unsigned char* bytes = HostBytes(b.descriptor_address + VkDeviceSize{i} * size, size);
+      const unsigned char* bytes = MappedBytesAt(state, b.descriptor_address + VkDeviceSize{i} * size, size);
       if (!bytes) {
         Skip(TracedSkip::kUnreadable);
         continue;
@@ -72,25 +72,6 @@ struct TracedJudge {
       const AccelerationStructureState& s = *live->structures[static_cast<std::size_t>(k)];
       Judge(b, DescribedStructure{s.handle, s.serial});
     }
-  }
-
-  // `size` bytes at a device address, where the app mapped the memory under a buffer holding them; null otherwise.
-  const unsigned char* HostBytes(VkDeviceAddress address, std::size_t size) const {
-    AddressHits hits;
-    state.buffer_addresses.FindContaining(address, hits);
-    for (const AddressHit& hit : hits) {
-      const std::optional<std::shared_ptr<const BufferState>> buffer = state.buffers.find(hit.buffer);
-      if (!buffer || !*buffer || !(*buffer)->bound || (*buffer)->memory_freed) continue;
-      const BufferState& bs = **buffer;
-      if (!bs.Contains(address - bs.device_address, size)) continue;
-      const std::optional<HostMapping> mapping = state.host_mappings.OfMemory(bs.memory);
-      if (!mapping) continue;
-      const VkDeviceSize at = bs.memory_offset + (address - bs.device_address);
-      const VkDeviceSize mapped = mapping->end - mapping->begin;
-      if (at < mapping->offset || at - mapping->offset > mapped || size > mapped - (at - mapping->offset)) continue;
-      return reinterpret_cast<const unsigned char*>(mapping->begin + (at - mapping->offset));
-    }
-    return nullptr;
   }
 
   void Judge(const TracedBinding& b, const DescribedStructure& d) const {

@@ -1,5 +1,7 @@
 #include "bound_structures.h"
 
+#include <utility>
+
 namespace asval {
 
 namespace {
@@ -40,17 +42,13 @@ void BoundStructures::BindDescriptorBuffers(uint32_t count, const VkDescriptorBu
   for (uint32_t i = 0; infos && i < count; ++i) descriptor_buffers_[i] = infos[i].address;
 }
 
-void BoundStructures::SetBufferOffsets(
-    Point point, uint32_t first_set, uint32_t count, const uint32_t* indices, const VkDeviceSize* offsets,
-    const std::vector<std::shared_ptr<const RayBindings::BufferBindings>>& bindings) {
+void BoundStructures::SetBufferOffset(Point point, uint32_t set, uint32_t index, VkDeviceSize offset,
+                                      std::shared_ptr<const RayBindings::BufferBindings> bindings) {
   Bound& b = bound_[point];
-  for (uint32_t i = 0; indices && offsets && i < count; ++i) {
-    const uint32_t set = first_set + i;
-    const VkDeviceAddress base = indices[i] < descriptor_buffers_.size() ? descriptor_buffers_[indices[i]] : 0;
-    At(b.buffer_sets, set) = BufferSet{true, indices[i], offsets[i], base, i < bindings.size() ? bindings[i] : nullptr};
-    if (set < b.sets.size()) b.sets[set] = VK_NULL_HANDLE;
-    if (set < b.pushed_sets.size()) b.pushed_sets[set] = PushState::kNone;
-  }
+  const VkDeviceAddress base = index < descriptor_buffers_.size() ? descriptor_buffers_[index] : 0;
+  At(b.buffer_sets, set) = BufferSet{true, index, offset, base, std::move(bindings)};
+  if (set < b.sets.size()) b.sets[set] = VK_NULL_HANDLE;
+  if (set < b.pushed_sets.size()) b.pushed_sets[set] = PushState::kNone;
 }
 
 void BoundStructures::BeginPush(Point point, uint32_t set) {

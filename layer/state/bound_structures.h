@@ -48,11 +48,10 @@ class BoundStructures {
   void BeginPush(Point point, uint32_t set);
   // vkCmdBindDescriptorBuffersEXT: the buffers' addresses by index (every bind point reads them).
   void BindDescriptorBuffers(uint32_t count, const VkDescriptorBufferBindingInfoEXT* infos);
-  // vkCmdSetDescriptorBufferOffsetsEXT: set first_set + i reads buffer indices[i] at offsets[i], laid out as
-  // bindings[i] (the pipeline layout's set layout there; null: none with structures).
-  void SetBufferOffsets(Point point, uint32_t first_set, uint32_t count, const uint32_t* indices,
-                        const VkDeviceSize* offsets,
-                        const std::vector<std::shared_ptr<const RayBindings::BufferBindings>>& bindings);
+  // vkCmdSetDescriptorBufferOffsetsEXT, one set of it: `set` reads buffer `index` at `offset`, laid out as
+  // `bindings` (the pipeline layout's set layout there; null: none with structures).
+  void SetBufferOffset(Point point, uint32_t set, uint32_t index, VkDeviceSize offset,
+                       std::shared_ptr<const RayBindings::BufferBindings> bindings);
   // vkCmdExecuteCommands: the bindings of the primary are undefined afterwards.
   void Forget() { Reset(); }
 

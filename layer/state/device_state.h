@@ -13,12 +13,12 @@
 #include "build_size_cache.h"
 #include "command_buffers.h"
 #include "concurrent_map.h"
-#include "destroyed_objects.h"
 #include "failure_injection.h"
-#include "history_state.h"
 #include "format_features.h"
+#include "history_state.h"
 #include "host_mappings.h"
 #include "live_structure_addresses.h"
+#include "object_lifetimes.h"
 #include "objects.h"
 #include "protect_marks.h"
 #include "ray_bindings.h"
@@ -109,12 +109,12 @@ class DeviceState {
   // Family lifetime (layer/checks/lifetime.h): destroys and frees judged against the work in flight, and why some of
   // that work could not be judged.
   struct LifetimeCounters {
-    std::atomic<uint64_t> calls_judged{0};    // destroys and frees of an object some work in flight may use
-    std::atomic<uint64_t> kept_back{0};       // destroys the layer made later (skipped by the app or protect mode)
-    std::atomic<uint64_t> skipped_no_fence{0};       // batches with no fence to ask
+    std::atomic<uint64_t> calls_judged{0};      // destroys and frees of an object some work in flight may use
+    std::atomic<uint64_t> kept_back{0};         // destroys the layer made later (skipped by the app or protect mode)
+    std::atomic<uint64_t> skipped_no_fence{0};  // batches with no fence to ask
     std::atomic<uint64_t> skipped_host_may_know{0};  // batches the host may know complete before their fence
     // At submission (layer/checks/recorded_objects.h): recorded objects found destroyed since the recording, and
-    // those whose destruction the layer no longer remembers (DestroyedObjects' ring passed them).
+    // those whose destruction the layer no longer remembers (ObjectLifetimes' ring passed them).
     std::atomic<uint64_t> recorded_judged{0};
     std::atomic<uint64_t> skipped_recorded_forgotten{0};
   };
@@ -127,8 +127,9 @@ class DeviceState {
   mutable TraceCounters trace_counters;
   // Shader modules, pipelines, layouts, templates and descriptor sets that hold acceleration structures.
   RayBindings ray_bindings;
-  // Structures and buffers destroyed lately (family lifetime): a command recorded before is judged at submission.
-  DestroyedObjects destroyed;
+  // When structures were created and structures and buffers destroyed (family lifetime): a command recorded before
+  // is judged at submission.
+  ObjectLifetimes lifetimes;
   // Calls protect mode kept from the driver, and whether an error judged at completion halted submissions
   // (protect_marks.h).
   ProtectCounters protect_counters;
@@ -139,9 +140,6 @@ class DeviceState {
   // The newest id given so far: an object created, bound or destroyed after this read gets a larger one. A command
   // records it (OpOrigin::recorded_at) without taking an id (a load, not a read-modify-write, per recorded command).
   uint64_t LastObjectId() const { return next_object_id_.load(std::memory_order_relaxed); }
-  // The newest structure's serial (AccelerationStructureState::serial; 0: none yet): a command recorded at or after
-  // it names no structure created since (history_apply.cpp: a handle reused after the recording).
-  std::atomic<uint64_t> last_structure_created{0};
 
  private:
   std::atomic<uint64_t> next_object_id_{0};

@@ -228,8 +228,10 @@ uint32_t BaseRecord(const HistoryStore& store, const AsOp& op, uint32_t dst_reco
 // What this operation left last time its batch was applied, when it is still there to share: its own parameters
 // (made from them, or compared equal), so finding it again in the source (update) or in dst (build) is finding
 // the same parameters. Null when it must compare.
-[[gnu::always_inline]] inline const std::shared_ptr<const BuildSnapshot>* RememberedSnapshot(
-    const HistoryStore& store, const OpBatch& batch, const AsOp& op, uint32_t dst_record) {
+[[gnu::always_inline]] inline const std::shared_ptr<const BuildSnapshot>* RememberedSnapshot(const HistoryStore& store,
+                                                                                             const OpBatch& batch,
+                                                                                             const AsOp& op,
+                                                                                             uint32_t dst_record) {
   std::shared_ptr<const BuildSnapshot>* memo = batch.AppliedSnapshot(op);
   if (!memo || !*memo) return nullptr;
   const uint32_t base_record = BaseRecord(store, op, dst_record);
@@ -270,8 +272,8 @@ std::shared_ptr<BuildActivity> BuiltActivity(const DeviceState& state, const His
   return captures ? CapturedActivity(state, store, op, *captures) : nullptr;
 }
 
-void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op,
-                Transaction* txn, SubmissionCaptures* captures) {
+void ApplyBuild(const DeviceState& state, HistoryStore& store, const OpBatch& batch, const AsOp& op, Transaction* txn,
+                SubmissionCaptures* captures) {
   const uint32_t record = store.RecordOf(op.dst);
   if (record != HistoryStore::kNoRecord && !op.geometries_unreadable &&
       store.HistoryAt(record).span.memory != VK_NULL_HANDLE) {
@@ -411,7 +413,7 @@ void ApplyDeserialize(const DeviceState& state, HistoryStore& store, const AsOp&
     h.activity = blob->history.activity;
   } else {
     h.kind = HistoryKind::kUnknown;
-    h.unknown_reason = blob                  ? UnknownReason::kCopiedFromUnknown
+    h.unknown_reason = blob                     ? UnknownReason::kCopiedFromUnknown
                        : op.memory.host_address ? UnknownReason::kDeserializedUnknownBytes
                                                 : UnknownReason::kDeserializedDeviceBytes;
   }
@@ -449,8 +451,7 @@ void ApplyWriteProperties(HistoryStore& store, const AsOp& op, Transaction* txn)
 // after the recording.
 bool NamesReplacedStructure(const DeviceState& state, const AsOp& op) {
   const uint64_t recorded_at = op.origin.recorded_at;
-  if (recorded_at == 0 || op.kind == OpKind::kTrace ||
-      state.last_structure_created.load(std::memory_order_acquire) <= recorded_at) {
+  if (recorded_at == 0 || op.kind == OpKind::kTrace || state.lifetimes.last_structure_created() <= recorded_at) {
     return false;
   }
   const auto replaced = [&](VkAccelerationStructureKHR as) {
@@ -480,7 +481,8 @@ void ApplyOnReplaced(const DeviceState& state, HistoryStore& store, const AsOp& 
     case OpKind::kSerialize:
       store.InvalidateAllBlobs(txn);
       return;
-    case OpKind::kTrace: return;
+    case OpKind::kTrace:
+      return;
   }
 }
 
@@ -523,12 +525,23 @@ void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch
   InjectBadAlloc(FailSite::kApply);  // the test hook: as if this operation's first allocation failed
   if (NamesReplacedStructure(state, op)) return ApplyOnReplaced(state, store, op, txn);
   switch (op.kind) {
-    case OpKind::kBuild: ApplyBuild(state, store, batch, op, txn, captures); break;
-    case OpKind::kCopy: ApplyCopy(state, store, op, txn); break;
-    case OpKind::kSerialize: ApplySerialize(store, op, txn, captures); break;
-    case OpKind::kDeserialize: ApplyDeserialize(state, store, op, txn, captures); break;
-    case OpKind::kWriteProperties: ApplyWriteProperties(store, op, txn); break;
-    case OpKind::kTrace: break;  // reads structures only (judged before: layer/checks/traced_structures.h)
+    case OpKind::kBuild:
+      ApplyBuild(state, store, batch, op, txn, captures);
+      break;
+    case OpKind::kCopy:
+      ApplyCopy(state, store, op, txn);
+      break;
+    case OpKind::kSerialize:
+      ApplySerialize(store, op, txn, captures);
+      break;
+    case OpKind::kDeserialize:
+      ApplyDeserialize(state, store, op, txn, captures);
+      break;
+    case OpKind::kWriteProperties:
+      ApplyWriteProperties(store, op, txn);
+      break;
+    case OpKind::kTrace:
+      break;  // reads structures only (judged before: layer/checks/traced_structures.h)
   }
 }
 

@@ -313,10 +313,12 @@ void RecordSetDescriptorBufferOffsets(DeviceState& state, VkCommandBuffer cb, Vk
   if (point == BoundStructures::kPointCount) return;
   CommandBufferState* recording = Following(state, cb);
   if (!recording) return;
+  if (!indices || !offsets) return;
   Guarded(state, [&] {
-    std::vector<std::shared_ptr<const RayBindings::BufferBindings>> bindings(count);
-    for (uint32_t i = 0; i < count; ++i) bindings[i] = state.ray_bindings.BufferBindingsOf(layout, first_set + i);
-    recording->bound_structures.SetBufferOffsets(point, first_set, count, indices, offsets, bindings);
+    for (uint32_t i = 0; i < count; ++i) {
+      recording->bound_structures.SetBufferOffset(point, first_set + i, indices[i], offsets[i],
+                                                  state.ray_bindings.BufferBindingsOf(layout, first_set + i));
+    }
   });
 }
 

@@ -73,7 +73,8 @@ void AllocateMemoryRecord(DeviceState& state, const VkMemoryAllocateInfo& info, 
     record->multi_instance = __builtin_popcount(flags->deviceMask) > 1;
   } else if (info.memoryTypeIndex < state.properties.memory.memoryTypeCount) {
     const uint32_t heap = state.properties.memory.memoryTypes[info.memoryTypeIndex].heapIndex;
-    record->multi_instance = state.features.physical_device_count > 1 && heap < state.properties.memory.memoryHeapCount &&
+    record->multi_instance = state.features.physical_device_count > 1 &&
+                             heap < state.properties.memory.memoryHeapCount &&
                              (state.properties.memory.memoryHeaps[heap].flags & VK_MEMORY_HEAP_MULTI_INSTANCE_BIT);
   }
   state.memories.insert_or_assign(memory, std::move(record));
@@ -83,9 +84,8 @@ void ForgetBuffersOfMemory(DeviceState& state, VkDeviceMemory memory) {
   // Buffers bound to it keep their binding (it never goes away) but no longer have bytes or a usable device
   // address: their ranges leave the address map, so that a buffer later given the same addresses in another
   // allocation is the only one a lookup finds, and their records forget the memory's handle value.
-  const auto bound = state.buffers.snapshot([memory](VkBuffer, const std::shared_ptr<const BufferState>& b) {
-    return b && b->bound && b->memory == memory;
-  });
+  const auto bound = state.buffers.snapshot(
+      [memory](VkBuffer, const std::shared_ptr<const BufferState>& b) { return b && b->bound && b->memory == memory; });
   bool storage = false;
   for (const auto& [handle, old] : bound) {
     if (old->device_address != 0) state.buffer_addresses.Erase(old->device_address, handle);
@@ -214,7 +214,7 @@ void RecordDestroyBuffer(DeviceState& state, VkBuffer buffer) {
     state.buffer_addresses.Erase((*record)->device_address, buffer);
     if (state.lifetime_tracked) {
       const BufferState& b = **record;
-      state.destroyed.AddBuffer({buffer, b.device_address, b.size, b.bound_serial, state.NextObjectId()});
+      state.lifetimes.AddBuffer({buffer, b.device_address, b.size, b.bound_serial, state.NextObjectId()});
     }
   }
   if (record && *record && ((*record)->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR)) {
@@ -230,25 +230,25 @@ void RecordBindBufferMemory(DeviceState& state, const DeviceDispatchTable& dispa
   try {
     InjectBadAlloc(FailSite::kObjectRecord);
     auto record = std::make_shared<BufferState>(**old);
-  record->bound = true;
-  record->memory = memory;
-  record->memory_offset = offset;
-  record->bound_serial = state.NextObjectId();
-  if ((record->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) && dispatch.GetBufferDeviceAddress) {
-    const VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, buffer};
-    record->device_address = dispatch.GetBufferDeviceAddress(device, &info);
-  }
-  if (record->device_address != 0) {
-    state.buffer_addresses.Insert(record->device_address, record->size, buffer);
-    inserted = record->device_address;
-  }
-  const bool storage = (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
-  std::shared_ptr<const BufferState> published = record;
-  state.buffers.insert_or_assign(buffer, std::move(record));
-  if (storage) state.structure_storage_changes.Bump();
-  if (storage && state.structures_awaiting_address.load(std::memory_order_relaxed) != 0) {
-    AddressStructuresOf(state, dispatch, device, *published);
-  }
+    record->bound = true;
+    record->memory = memory;
+    record->memory_offset = offset;
+    record->bound_serial = state.NextObjectId();
+    if ((record->usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) && dispatch.GetBufferDeviceAddress) {
+      const VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, buffer};
+      record->device_address = dispatch.GetBufferDeviceAddress(device, &info);
+    }
+    if (record->device_address != 0) {
+      state.buffer_addresses.Insert(record->device_address, record->size, buffer);
+      inserted = record->device_address;
+    }
+    const bool storage = (record->usage & VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR) != 0;
+    std::shared_ptr<const BufferState> published = record;
+    state.buffers.insert_or_assign(buffer, std::move(record));
+    if (storage) state.structure_storage_changes.Bump();
+    if (storage && state.structures_awaiting_address.load(std::memory_order_relaxed) != 0) {
+      AddressStructuresOf(state, dispatch, device, *published);
+    }
   } catch (const std::bad_alloc&) {
     // Kept unbound it would be reported as such: the buffer becomes unknown instead.
     state.failures().buffers_incomplete.store(true, std::memory_order_relaxed);
@@ -266,10 +266,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   auto record = std::make_shared<AccelerationStructureState>();
   record->handle = handle;
   record->serial = state.NextObjectId();
-  for (uint64_t newest = state.last_structure_created.load(std::memory_order_relaxed);
-       newest < record->serial &&
-       !state.last_structure_created.compare_exchange_weak(newest, record->serial, std::memory_order_release);) {
-  }
+  state.lifetimes.StructureCreated(record->serial);
   record->buffer = info.buffer;
   record->offset = info.offset;
   record->size = info.size;
@@ -300,7 +297,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
 void RecordDestroyAccelerationStructure(DeviceState& state, VkAccelerationStructureKHR handle) {
   std::optional<std::shared_ptr<const AccelerationStructureState>> record = state.acceleration_structures.pop(handle);
   if (record && *record && state.lifetime_tracked) {
-    state.destroyed.AddStructure({handle, (*record)->serial, state.NextObjectId()});
+    state.lifetimes.AddStructure({handle, (*record)->serial, state.NextObjectId()});
   }
   if (record && *record && (*record)->address == AccelerationStructureState::Address::kAwaitingBind) {
     state.structures_awaiting_address.fetch_sub(1, std::memory_order_relaxed);
@@ -366,7 +363,8 @@ DeviceFeatures ParseEnabledFeatures(const VkDeviceCreateInfo& info) {
         break;
       }
       case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES:
-        f.buffer_device_address |= reinterpret_cast<const VkPhysicalDeviceBufferDeviceAddressFeatures*>(s)->bufferDeviceAddress;
+        f.buffer_device_address |=
+            reinterpret_cast<const VkPhysicalDeviceBufferDeviceAddressFeatures*>(s)->bufferDeviceAddress;
         break;
       case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES_EXT:
         f.buffer_device_address |=

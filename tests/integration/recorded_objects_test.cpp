@@ -125,7 +125,7 @@ TEST_CASE(
       never_built.Update(c, Shape{});
     });
     blas.DestroyHandle();
-    // More destroys than the layer keeps (DestroyedObjects::kCapacity, 256): the one above is forgotten.
+    // More destroys than the layer keeps (ObjectLifetimes::kCapacity, 256): the one above is forgotten.
     Blas churn(device, inputs);
     for (int i = 0; i < 300; ++i) churn.Recreate();
     f.monitor().Expect(kUpdateOfUnbuilt);

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "destroyed_objects.h"
+#include "object_lifetimes.h"
 #include "ray_bindings.h"
 
 namespace asval {
@@ -17,40 +17,55 @@ VkBuffer BufferHandle(uint64_t value) { return reinterpret_cast<VkBuffer>(value)
 TEST_CASE(
     "lifetime unit: a structure is destroyed since a recording only when it lived then and went before the "
     "submission") {
-  DestroyedObjects destroyed;
+  ObjectLifetimes destroyed;
   CHECK(destroyed.last_structure_destroyed() == 0);
   destroyed.AddStructure({Handle(0x10), /*created=*/5, /*destroyed=*/20});
   CHECK(destroyed.last_structure_destroyed() == 20);
-  DestroyedObjects::Structure found{};
+  ObjectLifetimes::Structure found{};
   // Recorded at 10, submitted at 30: it lived at 10 and went at 20.
-  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {10, 30}, &found) == DestroyedObjects::Answer::kYes);
+  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {10, 30}, &found) == ObjectLifetimes::Answer::kYes);
   CHECK(found.created == 5);
   // Recorded after it went; recorded before it was created (the handle named another one then, or none).
-  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {25, 30}, &found) == DestroyedObjects::Answer::kNo);
-  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {3, 30}, &found) == DestroyedObjects::Answer::kNo);
+  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {25, 30}, &found) == ObjectLifetimes::Answer::kNo);
+  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {3, 30}, &found) == ObjectLifetimes::Answer::kNo);
   // Destroyed after the submission (a batch applied later): not the command buffer's state when it was submitted.
-  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {10, 15}, &found) == DestroyedObjects::Answer::kNo);
+  CHECK(destroyed.StructureDestroyedSince(Handle(0x10), {10, 15}, &found) == ObjectLifetimes::Answer::kNo);
   // Another handle.
-  CHECK(destroyed.StructureDestroyedSince(Handle(0x11), {10, 30}, &found) == DestroyedObjects::Answer::kNo);
+  CHECK(destroyed.StructureDestroyedSince(Handle(0x11), {10, 30}, &found) == ObjectLifetimes::Answer::kNo);
+}
+
+TEST_CASE(
+    "lifetime unit: the newest creation and destruction are maxima, whatever order threads hand their serials in") {
+  ObjectLifetimes lifetimes;
+  CHECK(lifetimes.last_structure_created() == 0);
+  lifetimes.StructureCreated(7);
+  lifetimes.StructureCreated(4);  // a thread that took its serial first and got here second
+  CHECK(lifetimes.last_structure_created() == 7);
+  lifetimes.AddStructure({Handle(0x10), 1, 30});
+  lifetimes.AddStructure({Handle(0x11), 2, 25});
+  CHECK(lifetimes.last_structure_destroyed() == 30);
+  lifetimes.AddBuffer({BufferHandle(0x20), 0x1000, 64, 3, 40});
+  lifetimes.AddBuffer({BufferHandle(0x21), 0x2000, 64, 3, 35});
+  CHECK(lifetimes.last_buffer_destroyed() == 40);
 }
 
 TEST_CASE(
     "lifetime unit: a buffer holds a recorded address when bound before the recording; the oldest destroys "
     "are forgotten, and what they could have answered is unknown") {
-  DestroyedObjects destroyed;
+  ObjectLifetimes destroyed;
   destroyed.AddBuffer({BufferHandle(0x20), /*address=*/0x1000, /*size=*/256, /*bound=*/4, /*destroyed=*/9});
-  DestroyedObjects::Buffer found{};
-  CHECK(destroyed.BufferDestroyedSince(0x10ff, {6, 50}, &found) == DestroyedObjects::Answer::kYes);
+  ObjectLifetimes::Buffer found{};
+  CHECK(destroyed.BufferDestroyedSince(0x10ff, {6, 50}, &found) == ObjectLifetimes::Answer::kYes);
   CHECK(found.handle == BufferHandle(0x20));
-  CHECK(destroyed.BufferDestroyedSince(0x1100, {6, 50}, &found) == DestroyedObjects::Answer::kNo);  // past its end
-  CHECK(destroyed.BufferDestroyedSince(0x1000, {3, 50}, &found) == DestroyedObjects::Answer::kNo);  // bound later
+  CHECK(destroyed.BufferDestroyedSince(0x1100, {6, 50}, &found) == ObjectLifetimes::Answer::kNo);  // past its end
+  CHECK(destroyed.BufferDestroyedSince(0x1000, {3, 50}, &found) == ObjectLifetimes::Answer::kNo);  // bound later
   // Fill the ring past its capacity with other buffers destroyed later: the first one is dropped.
-  for (uint64_t i = 0; i < DestroyedObjects::kCapacity; ++i) {
+  for (uint64_t i = 0; i < ObjectLifetimes::kCapacity; ++i) {
     destroyed.AddBuffer({BufferHandle(0x100 + i), 0x100000 + i * 0x1000, 256, 10 + i, 11 + i});
   }
-  CHECK(destroyed.BufferDestroyedSince(0x1000, {6, 5000}, &found) == DestroyedObjects::Answer::kUnknown);
+  CHECK(destroyed.BufferDestroyedSince(0x1000, {6, 5000}, &found) == ObjectLifetimes::Answer::kUnknown);
   // A recording made after every dropped destroy loses nothing.
-  CHECK(destroyed.BufferDestroyedSince(0x1000, {9, 5000}, &found) == DestroyedObjects::Answer::kNo);
+  CHECK(destroyed.BufferDestroyedSince(0x1000, {9, 5000}, &found) == ObjectLifetimes::Answer::kNo);
 }
 
 TEST_CASE(

@@ -1,13 +1,14 @@
 #pragma once
-// Structures and buffers destroyed lately, with when each came and went (DeviceState::NextObjectId), so that a
-// submission can tell a command recorded while the object it names lived from one recorded with a handle or address
-// that never named one (issue 29: a command buffer whose recorded structure or buffer was destroyed since is
-// invalid, VUID-vkQueueSubmit-pCommandBuffers-00070). Handles and addresses are reused: only the serials say which
-// object a recording named.
+// When structures and buffers came and went (DeviceState::NextObjectId), so that a submission can tell a command
+// recorded while the object it names lived from one recorded with a handle or address that never named one, or one
+// whose handle now names a newer object (issue 29: a command buffer whose recorded structure or buffer was destroyed
+// since is invalid, VUID-vkQueueSubmit-pCommandBuffers-00070). Handles and addresses are reused: only the serials say
+// which object a recording named.
 //
-// Two fixed rings (no allocation): the oldest entries are dropped, and a question about a recording older than the
-// newest dropped entry's destruction may have lost its answer: kUnknown (counted by the caller, never guessed).
-// Destroys are rare next to recorded commands: one lock for both rings.
+// The newest creation and destruction are kept as atomics (the one load a submission pays while nothing happened
+// since its recording); destroys are kept in two fixed rings (no allocation): the oldest entries are dropped, and a
+// question about a recording older than the newest dropped entry's destruction may have lost its answer: kUnknown
+// (counted by the caller, never guessed). Destroys are rare next to recorded commands: one lock for both rings.
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -18,7 +19,7 @@
 
 namespace asval {
 
-class DestroyedObjects {
+class ObjectLifetimes {
  public:
   static constexpr std::size_t kCapacity = 256;
 
@@ -36,11 +37,15 @@ class DestroyedObjects {
   };
   enum class Answer : uint8_t { kNo, kYes, kUnknown };
 
+  // A structure was created with this serial (AccelerationStructureState::serial).
+  void StructureCreated(uint64_t serial) { RaiseTo(structures_created_, serial); }
   void AddStructure(const Structure& structure);
   void AddBuffer(const Buffer& buffer);
 
-  // The newest destruction's serial (0: none yet). A recording made at or after it named nothing destroyed since:
-  // the one load a submission pays while nothing is destroyed.
+  // The newest creation's serial (0: none yet): a command recorded at or after it names no structure created since
+  // (history_apply.cpp: a handle reused after the recording).
+  uint64_t last_structure_created() const { return structures_created_.load(std::memory_order_acquire); }
+  // The newest destruction's serial (0: none yet). A recording made at or after it named nothing destroyed since.
   uint64_t last_structure_destroyed() const { return structures_last_.load(std::memory_order_acquire); }
   uint64_t last_buffer_destroyed() const { return buffers_last_.load(std::memory_order_acquire); }
 
@@ -86,9 +91,17 @@ class DestroyedObjects {
     }
   };
 
+  // Threads take serials before they get here: the newest is a maximum, not the last stored.
+  static void RaiseTo(std::atomic<uint64_t>& newest, uint64_t serial) {
+    for (uint64_t seen = newest.load(std::memory_order_relaxed);
+         seen < serial && !newest.compare_exchange_weak(seen, serial, std::memory_order_release);) {
+    }
+  }
+
   mutable std::mutex mutex_;
   Ring<Structure> structures_;
   Ring<Buffer> buffers_;
+  std::atomic<uint64_t> structures_created_{0};
   std::atomic<uint64_t> structures_last_{0};
   std::atomic<uint64_t> buffers_last_{0};
 };
