@@ -9,6 +9,7 @@
 
 #include "buffer_lookup.h"
 #include "structure_memory.h"
+#include "traced_structures.h"
 
 namespace asval {
 
@@ -78,6 +79,30 @@ constexpr const char kNotDone[] =
     "; that submission has not completed execution (its fence is unsignaled), and the device would read or write "
     "freed memory";
 
+// The first top level a batch's traces read whose build referenced a structure for which `named(as, serial)` holds
+// (traced_tops.h): the device traverses that structure (*bottom) while the batch runs. Null: none.
+template <typename Named>
+const InFlightBatch::TracedTop* TracedThrough(const InFlightBatch& b, Named&& named,
+                                              VkAccelerationStructureKHR* bottom = nullptr) {
+  for (const InFlightBatch::TracedTop& t : b.traced_tops) {
+    for (const ReferencedStructures::Referenced& r : t.references->structures) {
+      if (!named(r.as, r.serial)) continue;
+      if (bottom) *bottom = r.as;
+      return &t;
+    }
+  }
+  return nullptr;
+}
+
+std::string DescribeTraced(const InFlightBatch& b, const InFlightBatch::TracedTop& t) {
+  return fmt::format("{} traces the top-level VkAccelerationStructureKHR 0x{:x}, whose build it reads referenced it",
+                     Describe(b, *t.op), reinterpret_cast<uint64_t>(t.top));
+}
+
+constexpr const char kBottomLevelInvalidWhy[] =
+    ". Bottom-level structures must be valid when a top level referencing them is accessed (the chapter gives this "
+    "rule no VUID)";
+
 }  // namespace
 
 bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, VkAccelerationStructureKHR structure) {
@@ -91,29 +116,42 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
     });
     return used;
   };
+  // Family traces: a pending trace traverses it through a top level whose build referenced it.
+  const bool traces = ctx.Enabled(kCheckTraces);
+  const auto is_it = [&](VkAccelerationStructureKHR as, uint64_t serial) {
+    return as == structure && serial == record->serial;
+  };
   InFlightSkips skips;
-  std::vector<std::string> findings;  // reported once the in-flight set's lock is released
+  std::vector<std::pair<const char*, std::string>> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
       [&](const InFlightBatch& b) {
         if (b.serial < record->serial) return false;
         bool used = false;
         ForEachOp(b, [&](const RecordedOps& recorded, const AsOp& op) { used = used || uses(recorded, op); });
-        return used;
+        return used || (traces && TracedThrough(b, is_it));
       },
       [&](const InFlightBatch& b) {
         const AsOp* first = nullptr;
         ForEachOp(b, [&](const RecordedOps& recorded, const AsOp& op) {
           if (!first && uses(recorded, op)) first = &op;
         });
-        if (!first) return;
-        findings.push_back(fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
-                                       reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
+        if (first) {
+          findings.emplace_back(kStructureInUse,
+                                fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
+                                            reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
+        } else if (const InFlightBatch::TracedTop* t = traces ? TracedThrough(b, is_it) : nullptr) {
+          findings.emplace_back(
+              kBottomLevelInvalidId,
+              fmt::format("The bottom-level VkAccelerationStructureKHR 0x{:x} is destroyed while {}{}{}.",
+                          reinterpret_cast<uint64_t>(structure), DescribeTraced(b, *t), kNotDone,
+                          kBottomLevelInvalidWhy));
+        }
       },
       &skips);
   CountSkips(ctx, skips);
   bool skip = false;
-  for (const std::string& text : findings) {
-    skip |= Report(ctx, kStructureInUse, "vkDestroyAccelerationStructureKHR",
+  for (const auto& [id, text] : findings) {
+    skip |= Report(ctx, id, "vkDestroyAccelerationStructureKHR",
                    Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, structure), text);
   }
   return skip;
@@ -197,23 +235,45 @@ FoundUse FirstUse(const CheckContext& ctx, const InFlightBatch& b, const Going& 
   return found;
 }
 
+// bottom_levels: a structure going with the object that a pending trace traverses through a top level (family
+// traces) is reported too (a freed memory; a destroyed buffer whose memory stays is not judged, as at submission).
 template <typename Goes>
 bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, const char* function,
-                ReportObject object, const char* what, const Going& going_away, Goes&& goes) {
+                ReportObject object, const char* what, const Going& going_away, bool bottom_levels, Goes&& goes) {
   if (going_away.empty()) return false;  // no address and no structure: nothing in flight can use it
+  const bool traces = bottom_levels && ctx.Enabled(kCheckTraces) && !going_away.structures.empty();
+  const auto going_structure = [&](VkAccelerationStructureKHR as, uint64_t serial) {
+    if (!going_away.Names(as)) return false;
+    const std::optional<std::shared_ptr<const AccelerationStructureState>> live =
+        ctx.state.acceleration_structures.find(as);
+    return live && *live && (*live)->serial == serial;
+  };
   InFlightSkips skips;
-  std::vector<std::string> findings;  // reported once the in-flight set's lock is released
+  std::vector<std::pair<const char*, std::string>> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
-      [&](const InFlightBatch& b) { return FirstUse(ctx, b, going_away, goes).op != nullptr; },
+      [&](const InFlightBatch& b) {
+        return FirstUse(ctx, b, going_away, goes).op != nullptr || (traces && TracedThrough(b, going_structure));
+      },
       [&](const InFlightBatch& b) {
         const FoundUse use = FirstUse(ctx, b, going_away, goes);
-        if (!use.op) return;
-        findings.push_back(fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
+        if (use.op) {
+          findings.emplace_back(vuid,
+                                fmt::format("{} holds {} of {}{}.", what, use.how, Describe(b, *use.op), kNotDone));
+          return;
+        }
+        VkAccelerationStructureKHR bottom = VK_NULL_HANDLE;
+        const InFlightBatch::TracedTop* t = traces ? TracedThrough(b, going_structure, &bottom) : nullptr;
+        if (!t) return;
+        findings.emplace_back(kBottomLevelInvalidId,
+                              fmt::format("{} holds the storage of the bottom-level VkAccelerationStructureKHR 0x{:x} "
+                                          "while {}{}{}.",
+                                          what, reinterpret_cast<uint64_t>(bottom), DescribeTraced(b, *t), kNotDone,
+                                          kBottomLevelInvalidWhy));
       },
       &skips);
   CountSkips(ctx, skips);
   bool skip = false;
-  for (const std::string& text : findings) skip |= Report(ctx, vuid, function, object, text);
+  for (const auto& [id, text] : findings) skip |= Report(ctx, id, function, object, text);
   return skip;
 }
 
@@ -228,7 +288,7 @@ bool CheckDestroyBufferInUse(const CheckContext& ctx, InFlight& in_flight, VkBuf
   going.Add(ctx, **record);
   const std::string what = fmt::format("VkBuffer 0x{:x}", reinterpret_cast<uint64_t>(buffer));
   return CheckInUse(ctx, in_flight, kBufferInUse, "vkDestroyBuffer", Obj(VK_OBJECT_TYPE_BUFFER, buffer), what.c_str(),
-                    going, [&](const BufferState& holder) { return holder.id == id; });
+                    going, /*bottom_levels=*/false, [&](const BufferState& holder) { return holder.id == id; });
 }
 
 bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDeviceMemory memory) {
@@ -248,7 +308,8 @@ bool CheckFreeMemoryInUse(const CheckContext& ctx, InFlight& in_flight, VkDevice
     going.Add(ctx, *b);
   }
   return CheckInUse(ctx, in_flight, kMemoryInUse, "vkFreeMemory", Obj(VK_OBJECT_TYPE_DEVICE_MEMORY, memory),
-                    what.c_str(), going, [&](const BufferState& holder) { return holder.memory == memory; });
+                    what.c_str(), going, /*bottom_levels=*/true,
+                    [&](const BufferState& holder) { return holder.memory == memory; });
 }
 
 void ReportLifetimeSummary(const DeviceState& state, Reporter& reporter, VkDevice device) {

@@ -16,6 +16,7 @@
 #include "submission.h"
 #include "submit_checks.h"
 #include "synchronization_only.h"
+#include "traced_tops.h"
 #include "vk_intercepts.h"
 #include "withhold.h"
 
@@ -74,10 +75,12 @@ VkResult SynchronizeWithheld(DeviceData& data, const char* function, VkQueue que
 // Family lifetime (in_flight.h): the batches of a submission that use structures, buffers or memory, staged before
 // the downcall with the semaphores through which their completion may be learned. A wait of any submission for a
 // binary semaphore that a batch of another queue signals is noted (that batch may be seen complete through it).
+// `submission`: the call's history submission, whose batches were all applied now (in execution order) when
+// `applied_now`; the top levels their traces read are then kept with them (traced_tops.h).
 template <typename SemaphoresOf, typename ForEachCommandBufferIn>
 void StageInFlight(DeviceData& data, const char* function, VkQueue queue, uint32_t batch_count,
                    SemaphoresOf&& semaphores_of, ForEachCommandBufferIn&& for_each_command_buffer_in,
-                   std::vector<InFlightBatch>& staging) {
+                   uint64_t submission, bool applied_now, std::vector<InFlightBatch>& staging) {
   InFlight& in_flight = *data.in_flight;
   SubmissionOrder& order = data.state.history.order;
   std::unique_lock<std::recursive_mutex> order_lock;  // timeline types are known under the order lock
@@ -118,6 +121,7 @@ void StageInFlight(DeviceData& data, const char* function, VkQueue queue, uint32
       }
     }
   }
+  if (applied_now) NoteTracedTops(data.state, submission, staging, first);
 }
 
 // semaphores_of(i): batch i's BatchSemaphores; for_each_command_buffer_in(i, visit) calls visit(cb, location, j)
@@ -153,9 +157,11 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   HistorySubmission submission(data.state);
   SubmitChecks checks(ctx, submission.captures().id);
   uint64_t unordered_batches = 0, unordered_ops = 0;
+  bool applied_now = true;
   for (uint32_t i = 0; i < batch_count; ++i) {
     const Placement place = call ? call->Place(semaphores_of(i)) : Placement::kNow;
     unordered_batches += place == Placement::kUnordered;
+    applied_now &= place == Placement::kNow;
     for_each_command_buffer_in(i, [&](VkCommandBuffer cb, const Location& loc, uint32_t j) {
       if (place == Placement::kNow) return submission.Apply(cb, checks.For(cb, loc));
       std::shared_ptr<const RecordedOps> ops;
@@ -189,7 +195,8 @@ VkResult Submit(DeviceData& data, const char* function, VkQueue queue, VkFence f
   VkFence in_flight_fence = VK_NULL_HANDLE;
   if (data.in_flight) {
     try {
-      StageInFlight(data, function, queue, batch_count, semaphores_of, for_each_command_buffer_in, in_flight);
+      StageInFlight(data, function, queue, batch_count, semaphores_of, for_each_command_buffer_in,
+                    submission.captures().id, applied_now, in_flight);
     } catch (const std::bad_alloc&) {
       data.state.failures().allocation_failures.fetch_add(1, std::memory_order_relaxed);
       data.in_flight->Abandon(in_flight);  // not tracked: their destroys are not judged

@@ -23,6 +23,7 @@ void Clear(InFlightBatch& b) {
   b.complete = false;
   b.host_may_know = false;
   b.recorded.clear();
+  b.traced_tops.clear();
   b.timeline_signals.clear();
   b.binary_signals.clear();
 }

@@ -31,6 +31,7 @@
 #include <mutex>
 #include <vector>
 
+#include "build_activity.h"
 #include "command_buffers.h"
 #include "submission_order.h"
 #include "vk_dispatch_table.h"
@@ -48,6 +49,15 @@ struct InFlightBatch {
   bool host_may_know = false;      // its completion may be known before its fence signals: skipped, counted
   // What its command buffers do, in order (each a published recording: immutable).
   std::vector<std::shared_ptr<const RecordedOps>> recorded;
+  // Top-level structures its traces and ray queries read through bound descriptors, with what the build they read
+  // referenced (traced_tops.h; family traces: a bottom level destroyed, or its memory freed, while such a trace is
+  // pending). Distinct by references; usually empty.
+  struct TracedTop {
+    VkAccelerationStructureKHR top = VK_NULL_HANDLE;
+    const AsOp* op = nullptr;  // the first trace reading it (in `recorded`)
+    std::shared_ptr<const ReferencedStructures> references;
+  };
+  std::vector<TracedTop> traced_tops;
   // Timeline values signaled by this batch or a later batch of its submission: reached, it completed.
   std::vector<SemaphoreUse> timeline_signals;
   // Binary semaphores it (or a later batch of its submission) signals: waited on another queue, host_may_know.

@@ -7,6 +7,8 @@
 #include <memory>
 #include <mutex>
 
+#include "submission_hold.h"
+
 namespace asval_test_driver {
 
 class DeviceExecutor;
@@ -45,7 +47,8 @@ struct DeviceFunctions {
   X(CmdCopyAccelerationStructureToMemoryKHR) X(CmdCopyMemoryToAccelerationStructureKHR)                   \
   X(CmdWriteAccelerationStructuresPropertiesKHR) X(DestroyDeferredOperationKHR)                          \
   X(ResetCommandBuffer) X(CmdExecuteCommands) X(CmdCopyBuffer) X(BindBufferMemory2)                  \
-  X(GetBufferMemoryRequirements2) X(GetDeviceBufferMemoryRequirements)
+  X(GetBufferMemoryRequirements2) X(GetDeviceBufferMemoryRequirements) X(CreateSemaphore) X(DestroySemaphore) \
+  X(SignalSemaphore)
 // clang-format on
 #define ASVAL_DRIVER_DECLARE(name) PFN_vk##name name = nullptr;
   ASVAL_DRIVER_DEVICE_FUNCTIONS(ASVAL_DRIVER_DECLARE)
@@ -65,6 +68,7 @@ struct DeviceData {
   std::unique_ptr<DeferredOperations> deferred;
   std::unique_ptr<DeviceBuffers> buffers;
   std::unique_ptr<IndirectBuilds> indirect;
+  SubmissionHold hold;  // under queue_lock (submission_hold.h)
 };
 
 void* DispatchKey(const void* handle);

@@ -194,6 +194,7 @@ VKAPI_ATTR void VKAPI_CALL DestroyDevice(VkDevice handle, const VkAllocationCall
   if (device == nullptr) return;
   device->indirect.reset();  // their pools and fence belong to the device
   device->executor.reset();
+  device->hold.Destroy(*device);
   const PFN_vkDestroyDevice destroy = device->vk.DestroyDevice;
   RemoveDevice(handle);
   destroy(handle, allocator);
@@ -212,7 +213,7 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit(VkQueue queue, uint32_t count, const 
   std::lock_guard<std::mutex> lock(device->queue_lock);
   const VkResult prepared = device->indirect->Prepare(queue, command_buffers);
   if (prepared != VK_SUCCESS) return prepared;
-  return device->vk.QueueSubmit(queue, count, submits, fence);
+  return device->vk.QueueSubmit(queue, count, device->hold.Submits(count, submits), fence);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t count, const VkSubmitInfo2* submits,
@@ -227,7 +228,14 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueSubmit2(VkQueue queue, uint32_t count, const
   std::lock_guard<std::mutex> lock(device->queue_lock);
   const VkResult prepared = device->indirect->Prepare(queue, command_buffers);
   if (prepared != VK_SUCCESS) return prepared;
-  return device->vk.QueueSubmit2(queue, count, submits, fence);
+  return device->vk.QueueSubmit2(queue, count, device->hold.Submits2(count, submits), fence);
+}
+
+// Test-only (submission_hold.h).
+VKAPI_ATTR VkResult VKAPI_CALL AsvalTestDriverHoldSubmissions(VkDevice handle, VkBool32 hold) {
+  DeviceData* device = FindDevice(handle);
+  std::lock_guard<std::mutex> lock(device->queue_lock);
+  return device->hold.Hold(*device, hold == VK_TRUE);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer command_buffer,
@@ -392,6 +400,7 @@ PFN_vkVoidFunction DeviceFunction(const char* name) {
   ASVAL_DRIVER_HOOK(DestroyDevice)
   ASVAL_DRIVER_HOOK(QueueSubmit)
   ASVAL_DRIVER_HOOK(QueueSubmit2)
+  ASVAL_DRIVER_HOOK(AsvalTestDriverHoldSubmissions)
   ASVAL_DRIVER_HOOK(QueueWaitIdle)
   ASVAL_DRIVER_HOOK(GetAccelerationStructureBuildSizesKHR)
   ASVAL_DRIVER_HOOK(BuildAccelerationStructuresKHR)

@@ -4,8 +4,10 @@
 #include <catch2/catch_test_macros.hpp>
 #include <functional>
 
+#include "on_test_driver.h"
 #include "ray_program.h"
 #include "temp_report.h"
+#include "test_driver_api.h"
 
 namespace asval_test {
 namespace {
@@ -471,6 +473,87 @@ TEST_CASE("lifetime valid twin: a traced top level's storage buffer destroyed, o
       false, [](Tlas& tlas) { tlas.DestroyStorageBuffer(); }, nullptr);
   StorageGoesWhileQueryPending(
       false, [](Tlas& tlas) { tlas.FreeStorageMemory(); }, nullptr);
+}
+
+// A bottom level the pending ray query traverses through the top level (whose build, completed before the query's
+// submission, referenced it): destroyed, or its memory freed. Reported at the destroy (family traces) and kept back by
+// the layer until the query completed (the monitor's VK_TRUE), so lavapipe never traverses freed memory. The query is
+// held pending by the test driver (submission_hold.h), below asval: asval sees a batch with no wait, applied at once,
+// as a busy GPU's would be (a wait asval sees defers the batch, judged when it is applied: traces_test's submit-time
+// cases). `rebuilt`: the top level was rebuilt without it (waited for) before the query's submission; `pending`
+// false: the query completed (waited for) before the destroy.
+void BottomLevelGoesWhileQueryPending(bool pending, bool rebuilt, const std::function<void(Blas&)>& goes,
+                                      const char* id) {
+  OnTestDriver on_test_driver;
+  HistoryFixture f(id ? "lifetime,traces" : nullptr, {}, RayTimelineDevice());
+  vkkit::Device& device = f.device();
+  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
+      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
+  REQUIRE(hold != nullptr);
+  Commands commands(device);
+  RayScene scene(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  Blas replacement(device, scene.inputs);
+  if (rebuilt) {
+    vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
+    REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+              replacement.Build(c, Shape{});
+              commands.Barrier(c);
+              scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+            })) == VK_SUCCESS);
+    device.Destroy(instances);
+  }
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  if (pending) REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
+  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
+  if (!pending) REQUIRE(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  if (id) f.monitor().Expect(id);
+  goes(scene.blas);
+  CHECK(f.monitor().Verify() == "");
+  if (pending) {
+    CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
+    CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  }
+  CHECK(program.hit() == 1u);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "traces: a bottom level destroyed while a pending ray query traverses it through the top level is reported "
+    "(ASVAL-Traces-BottomLevelInvalid)",
+    "[integration][lifetime][traces]") {
+  BottomLevelGoesWhileQueryPending(
+      true, false, [](Blas& blas) { blas.DestroyHandle(); }, "ASVAL-Traces-BottomLevelInvalid");
+}
+
+TEST_CASE(
+    "traces: a bottom level's memory freed while a pending ray query traverses it through the top level is reported "
+    "(ASVAL-Traces-BottomLevelInvalid)",
+    "[integration][lifetime][traces]") {
+  BottomLevelGoesWhileQueryPending(
+      true, false, [](Blas& blas) { blas.FreeStorageMemory(); }, "ASVAL-Traces-BottomLevelInvalid");
+}
+
+TEST_CASE(
+    "traces valid twin: a bottom level destroyed or its memory freed after the query traversing it completed, or "
+    "while a query over a top level rebuilt without it is pending, or its buffer destroyed (memory kept), stays "
+    "silent",
+    "[integration][lifetime][traces]") {
+  BottomLevelGoesWhileQueryPending(
+      false, false, [](Blas& blas) { blas.DestroyHandle(); }, nullptr);
+  BottomLevelGoesWhileQueryPending(
+      false, false, [](Blas& blas) { blas.FreeStorageMemory(); }, nullptr);
+  BottomLevelGoesWhileQueryPending(
+      true, true, [](Blas& blas) { blas.DestroyHandle(); }, nullptr);
+  BottomLevelGoesWhileQueryPending(
+      true, true, [](Blas& blas) { blas.FreeStorageMemory(); }, nullptr);
+  BottomLevelGoesWhileQueryPending(
+      true, false, [](Blas& blas) { blas.DestroyStorageBuffer(); }, nullptr);
 }
 
 }  // namespace

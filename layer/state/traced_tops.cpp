@@ -1,0 +1,79 @@
+#include "traced_tops.h"
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+
+namespace asval {
+
+namespace {
+
+bool HasTraces(const std::vector<InFlightBatch>& staged, std::size_t first) {
+  for (std::size_t k = first; k < staged.size(); ++k) {
+    for (const std::shared_ptr<const RecordedOps>& recorded : staged[k].recorded) {
+      if (recorded && recorded->batch.traced().size() != 0) return true;
+    }
+  }
+  return false;
+}
+
+// Whether a command of the submission names `as` as what it writes: a trace before it may have read an older build,
+// one after it reads this write; neither is known here.
+bool WrittenIn(const std::vector<InFlightBatch>& staged, std::size_t first, VkAccelerationStructureKHR as) {
+  for (std::size_t k = first; k < staged.size(); ++k) {
+    for (const std::shared_ptr<const RecordedOps>& recorded : staged[k].recorded) {
+      if (!recorded) continue;
+      for (const AsOp& op : recorded->batch.ops()) {
+        if (op.dst == as && op.kind != OpKind::kTrace && op.kind != OpKind::kWriteProperties) return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<InFlightBatch>& staged,
+                    std::size_t first) {
+  if (!state.history_tracked || !HasTraces(staged, first)) return;
+  const std::unique_lock<std::mutex> lock = state.history.store.Lock();
+  const HistoryStore& store = state.history.store;
+  for (std::size_t k = first; k < staged.size(); ++k) {
+    InFlightBatch& batch = staged[k];
+    for (const std::shared_ptr<const RecordedOps>& recorded : batch.recorded) {
+      if (!recorded || recorded->batch.traced().size() == 0) continue;
+      for (const AsOp& op : recorded->batch.ops()) {
+        if (op.kind != OpKind::kTrace) continue;
+        const auto read = [&](VkAccelerationStructureKHR as, uint64_t serial) {
+          if (!as || serial == 0) return;
+          const std::optional<std::shared_ptr<const AccelerationStructureState>> live =
+              state.acceleration_structures.find(as);
+          if (!live || !*live || (*live)->serial != serial) return;
+          const AsHistory* h = store.Find(as);
+          if (!h || h->kind != HistoryKind::kBuilt || !h->build || !h->activity ||
+              h->build->type == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR) {
+            return;
+          }
+          const uint64_t built_in = h->activity->submission();
+          if (built_in == 0 || built_in == submission) return;
+          std::shared_ptr<const ReferencedStructures> references = h->activity->references();
+          if (!references || references->structures.empty()) return;
+          const bool kept = std::any_of(batch.traced_tops.begin(), batch.traced_tops.end(),
+                                        [&](const InFlightBatch::TracedTop& t) { return t.references == references; });
+          if (kept || WrittenIn(staged, first, as)) return;
+          batch.traced_tops.push_back({as, &op, std::move(references)});
+        };
+        const TracedBinding* bindings = recorded->batch.traced().begin() + op.first_geometry;
+        for (uint32_t i = 0; i < op.geometry_count; ++i) {
+          const TracedBinding& b = bindings[i];
+          if (b.source == TracedSource::kPushed) read(b.pushed, b.pushed_serial);
+          if (b.source == TracedSource::kSet) {
+            state.ray_bindings.ForEachIn(b.set, b.binding, [&](const DescribedStructure& d) { read(d.as, d.serial); });
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace asval
