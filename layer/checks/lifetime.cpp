@@ -79,15 +79,18 @@ constexpr const char kNotDone[] =
     "; that submission has not completed execution (its fence is unsignaled), and the device would read or write "
     "freed memory";
 
-// The first top level a batch's traces read whose build referenced a structure for which `named(as, serial)` holds
-// (traced_tops.h): the device traverses that structure (*bottom) while the batch runs. Null: none.
-template <typename Named>
-const InFlightBatch::TracedTop* TracedThrough(const InFlightBatch& b, Named&& named,
-                                              VkAccelerationStructureKHR* bottom = nullptr) {
+// The first top level a batch's traces read whose build referenced a structure of `candidates` that is still the one
+// referenced (`serial_of(as)`: its live serial, 0 when none): the device traverses it (*bottom) while the batch runs
+// (traced_tops.h). Null: none. A binary search per candidate and top level.
+template <typename SerialOf>
+const InFlightBatch::TracedTop* TracedThrough(const InFlightBatch& b, const VkAccelerationStructureKHR* candidates,
+                                              std::size_t count, SerialOf&& serial_of,
+                                              VkAccelerationStructureKHR* bottom) {
   for (const InFlightBatch::TracedTop& t : b.traced_tops) {
-    for (const ReferencedStructures::Referenced& r : t.references->structures) {
-      if (!named(r.as, r.serial)) continue;
-      if (bottom) *bottom = r.as;
+    for (std::size_t k = 0; k < count; ++k) {
+      const ReferencedStructures::Referenced* r = t.references->Find(candidates[k]);
+      if (!r || r->serial != serial_of(candidates[k])) continue;
+      *bottom = candidates[k];
       return &t;
     }
   }
@@ -118,8 +121,10 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
   };
   // Family traces: a pending trace traverses it through a top level whose build referenced it.
   const bool traces = ctx.Enabled(kCheckTraces);
-  const auto is_it = [&](VkAccelerationStructureKHR as, uint64_t serial) {
-    return as == structure && serial == record->serial;
+  const auto serial_of = [&](VkAccelerationStructureKHR) { return record->serial; };
+  const auto traced_through = [&](const InFlightBatch& b) {
+    VkAccelerationStructureKHR bottom = VK_NULL_HANDLE;
+    return traces ? TracedThrough(b, &structure, 1, serial_of, &bottom) : nullptr;
   };
   InFlightSkips skips;
   std::vector<std::pair<const char*, std::string>> findings;  // reported once the in-flight set's lock is released
@@ -128,7 +133,7 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
         if (b.serial < record->serial) return false;
         bool used = false;
         ForEachOp(b, [&](const RecordedOps& recorded, const AsOp& op) { used = used || uses(recorded, op); });
-        return used || (traces && TracedThrough(b, is_it));
+        return used || traced_through(b) != nullptr;
       },
       [&](const InFlightBatch& b) {
         const AsOp* first = nullptr;
@@ -139,7 +144,7 @@ bool CheckDestroyStructureInUse(const CheckContext& ctx, InFlight& in_flight, Vk
           findings.emplace_back(kStructureInUse,
                                 fmt::format("VkAccelerationStructureKHR 0x{:x} is destroyed while {} uses it{}.",
                                             reinterpret_cast<uint64_t>(structure), Describe(b, *first), kNotDone));
-        } else if (const InFlightBatch::TracedTop* t = traces ? TracedThrough(b, is_it) : nullptr) {
+        } else if (const InFlightBatch::TracedTop* t = traced_through(b)) {
           findings.emplace_back(
               kBottomLevelInvalidId,
               fmt::format("The bottom-level VkAccelerationStructureKHR 0x{:x} is destroyed while {}{}{}.",
@@ -242,17 +247,21 @@ bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, 
                 ReportObject object, const char* what, const Going& going_away, bool bottom_levels, Goes&& goes) {
   if (going_away.empty()) return false;  // no address and no structure: nothing in flight can use it
   const bool traces = bottom_levels && ctx.Enabled(kCheckTraces) && !going_away.structures.empty();
-  const auto going_structure = [&](VkAccelerationStructureKHR as, uint64_t serial) {
-    if (!going_away.Names(as)) return false;
+  const auto serial_of = [&](VkAccelerationStructureKHR as) -> uint64_t {
     const std::optional<std::shared_ptr<const AccelerationStructureState>> live =
         ctx.state.acceleration_structures.find(as);
-    return live && *live && (*live)->serial == serial;
+    return live && *live ? (*live)->serial : 0;
+  };
+  const auto traced_through = [&](const InFlightBatch& b, VkAccelerationStructureKHR* bottom) {
+    return traces ? TracedThrough(b, going_away.structures.data(), going_away.structures.size(), serial_of, bottom)
+                  : nullptr;
   };
   InFlightSkips skips;
   std::vector<std::pair<const char*, std::string>> findings;  // reported once the in-flight set's lock is released
   in_flight.ForEachRunning(
       [&](const InFlightBatch& b) {
-        return FirstUse(ctx, b, going_away, goes).op != nullptr || (traces && TracedThrough(b, going_structure));
+        VkAccelerationStructureKHR bottom = VK_NULL_HANDLE;
+        return FirstUse(ctx, b, going_away, goes).op != nullptr || traced_through(b, &bottom) != nullptr;
       },
       [&](const InFlightBatch& b) {
         const FoundUse use = FirstUse(ctx, b, going_away, goes);
@@ -262,7 +271,7 @@ bool CheckInUse(const CheckContext& ctx, InFlight& in_flight, const char* vuid, 
           return;
         }
         VkAccelerationStructureKHR bottom = VK_NULL_HANDLE;
-        const InFlightBatch::TracedTop* t = traces ? TracedThrough(b, going_structure, &bottom) : nullptr;
+        const InFlightBatch::TracedTop* t = traced_through(b, &bottom);
         if (!t) return;
         findings.emplace_back(kBottomLevelInvalidId,
                               fmt::format("{} holds the storage of the bottom-level VkAccelerationStructureKHR 0x{:x} "

@@ -7,6 +7,7 @@
 // Created pending when a submission is applied (submission order), filled when that submission completes
 // (CaptureTracker, layer/capture), in submission order, under the device's capture processing lock, which every
 // reader holds too.
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
@@ -56,8 +57,15 @@ struct ReferencedStructures {
     std::shared_ptr<const BuildSnapshot> build;
     uint64_t generation = 0;
   };
-  std::vector<Referenced> structures;
+  std::vector<Referenced> structures;  // ordered by handle once published (RememberReferencedBuilds)
   mutable std::atomic<uint64_t> verified_structures{0};
+
+  // The entry of `as`, or null.
+  const Referenced* Find(VkAccelerationStructureKHR as) const {
+    const auto at = std::lower_bound(structures.begin(), structures.end(), as,
+                                     [](const Referenced& r, VkAccelerationStructureKHR h) { return r.as < h; });
+    return at != structures.end() && at->as == as ? &*at : nullptr;
+  }
 };
 
 class BuildActivity {

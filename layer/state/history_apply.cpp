@@ -1,5 +1,6 @@
 #include "history_apply.h"
 
+#include <algorithm>
 #include <cstring>
 #include <new>
 
@@ -546,6 +547,9 @@ void ApplyOp(const DeviceState& state, HistoryStore& store, const OpBatch& batch
 }
 
 void RememberReferencedBuilds(const HistoryStore& store, ReferencedStructures& references) {
+  std::sort(
+      references.structures.begin(), references.structures.end(),
+      [](const ReferencedStructures::Referenced& a, const ReferencedStructures::Referenced& b) { return a.as < b.as; });
   const std::unique_lock<std::mutex> lock = store.Lock();
   for (ReferencedStructures::Referenced& r : references.structures) {
     const AsHistory* h = store.Find(r.as);

@@ -35,7 +35,8 @@ void MakeAllUnknownAfterFailure(const DeviceState& state, HistoryStore& store);
 
 // A top-level build's references, found when its submission completed (family traces): each referenced structure
 // gets the build that last executed on it as the store holds it now, to tell a later rebuild of another layout
-// from it. Takes the store's lock itself (the capture processing lock may be held).
+// from it; they are ordered by handle (ReferencedStructures::Find). Takes the store's lock itself (the capture
+// processing lock may be held).
 void RememberReferencedBuilds(const HistoryStore& store, ReferencedStructures& references);
 
 // Serialization sizes read back on the host (vkWriteAccelerationStructuresPropertiesKHR, or a query result

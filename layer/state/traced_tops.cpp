@@ -17,19 +17,39 @@ bool HasTraces(const std::vector<InFlightBatch>& staged, std::size_t first) {
   return false;
 }
 
-// Whether a command of the submission names `as` as what it writes: a trace before it may have read an older build,
-// one after it reads this write; neither is known here.
-bool WrittenIn(const std::vector<InFlightBatch>& staged, std::size_t first, VkAccelerationStructureKHR as) {
-  for (std::size_t k = first; k < staged.size(); ++k) {
-    for (const std::shared_ptr<const RecordedOps>& recorded : staged[k].recorded) {
-      if (!recorded) continue;
-      for (const AsOp& op : recorded->batch.ops()) {
-        if (op.dst == as && op.kind != OpKind::kTrace && op.kind != OpKind::kWriteProperties) return true;
+// The structures the submission's commands write (their destinations), sorted: a trace before such a write may have
+// read an older build, one after it reads this write; neither is known here. Made once per submission, and only when
+// a traced top level is otherwise certain (rare: a top level built in an earlier submission and written again here).
+class WrittenIn {
+ public:
+  WrittenIn(const std::vector<InFlightBatch>& staged, std::size_t first) : staged_(staged), first_(first) {}
+  bool Names(VkAccelerationStructureKHR as) {
+    if (!made_) Make();
+    return std::binary_search(written_.begin(), written_.end(), as);
+  }
+
+ private:
+  void Make() {
+    made_ = true;
+    written_.clear();
+    for (std::size_t k = first_; k < staged_.size(); ++k) {
+      for (const std::shared_ptr<const RecordedOps>& recorded : staged_[k].recorded) {
+        if (!recorded) continue;
+        for (const AsOp& op : recorded->batch.ops()) {
+          if (op.dst && op.kind != OpKind::kTrace && op.kind != OpKind::kWriteProperties) written_.push_back(op.dst);
+        }
       }
     }
+    std::sort(written_.begin(), written_.end());
   }
-  return false;
-}
+
+  const std::vector<InFlightBatch>& staged_;
+  std::size_t first_;
+  bool made_ = false;
+  // This thread's, kept with its capacity.
+  static thread_local std::vector<VkAccelerationStructureKHR> written_;
+};
+thread_local std::vector<VkAccelerationStructureKHR> WrittenIn::written_;
 
 }  // namespace
 
@@ -38,6 +58,7 @@ void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<I
   if (!state.history_tracked || !HasTraces(staged, first)) return;
   const std::unique_lock<std::mutex> lock = state.history.store.Lock();
   const HistoryStore& store = state.history.store;
+  WrittenIn written(staged, first);
   for (std::size_t k = first; k < staged.size(); ++k) {
     InFlightBatch& batch = staged[k];
     for (const std::shared_ptr<const RecordedOps>& recorded : batch.recorded) {
@@ -60,7 +81,7 @@ void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<I
           if (!references || references->structures.empty()) return;
           const bool kept = std::any_of(batch.traced_tops.begin(), batch.traced_tops.end(),
                                         [&](const InFlightBatch::TracedTop& t) { return t.references == references; });
-          if (kept || WrittenIn(staged, first, as)) return;
+          if (kept || written.Names(as)) return;
           batch.traced_tops.push_back({as, &op, std::move(references)});
         };
         const TracedBinding* bindings = recorded->batch.traced().begin() + op.first_geometry;

@@ -556,5 +556,48 @@ TEST_CASE(
       true, false, [](Blas& blas) { blas.DestroyStorageBuffer(); }, nullptr);
 }
 
+TEST_CASE(
+    "traces valid twin: a top level cloned over after the pending query read it, in the query's submission, is not "
+    "taken for what the query read: a bottom level the clone's source references, destroyed then, stays silent",
+    "[integration][lifetime][traces]") {
+  OnTestDriver on_test_driver;
+  HistoryFixture f(nullptr, {}, RayTimelineDevice());
+  vkkit::Device& device = f.device();
+  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
+      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
+  REQUIRE(hold != nullptr);
+  Commands commands(device);
+  RayScene scene(device);
+  Blas replacement(device, scene.inputs);
+  Tlas other(device);
+  vkkit::Buffer instances = other.MakeInstances({&replacement});
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
+            scene.Build(commands, c);
+            replacement.Build(c, Shape{});
+            commands.Barrier(c);
+            other.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+          })) == VK_SUCCESS);
+  RayProgram program(device, RayProgram::Kind::kRayQuery);
+  program.Write(scene.tlas.handle());
+  // The query reads the top level referencing scene.blas; the clone then makes it reference `replacement`.
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) {
+    program.Record(c);
+    commands.Barrier(c);
+    CmdCopy(device, c, other.handle(), scene.tlas.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
+  });
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
+  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
+  replacement.DestroyHandle();  // what the clone's source references: not what the query traverses
+  CHECK(f.monitor().Verify() == "");
+  CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
+  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(program.hit() == 1u);
+  device.Destroy(instances);
+  CHECK(f.monitor().Verify() == "");
+}
+
 }  // namespace
 }  // namespace asval_test
