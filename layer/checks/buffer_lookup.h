@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "buffer_holders.h"  // ForEachBufferHolding, MappedBytesAt
 #include "device_state.h"
 
 namespace asval {
@@ -19,23 +20,6 @@ namespace asval {
 // allocation failed), an address not found is unknown: a hit naming no buffer, the skip counted.
 std::optional<AddressHit> FindBufferHolding(const DeviceState& state, VkDeviceAddress address, VkDeviceSize size,
                                             VkBufferUsageFlags usage);
-
-// Calls hold(const BufferState&) for every live buffer bound before the id `bound_by` (BufferState::bound_serial <=
-// bound_by) whose device-address range holds `address`: the buffers a command recorded or submitted at that id may
-// have meant. The shared question of the lifetime rules (a destroy at submission, a recording judged at submission).
-template <typename Hold>
-void ForEachBufferHolding(const DeviceState& state, VkDeviceAddress address, uint64_t bound_by, Hold&& hold) {
-  AddressHits hits;
-  state.buffer_addresses.FindContaining(address, hits);
-  for (const AddressHit& hit : hits) {
-    const std::optional<std::shared_ptr<const BufferState>> b = state.buffers.find(hit.buffer);
-    if (b && *b && (*b)->bound && (*b)->bound_serial <= bound_by) hold(**b);
-  }
-}
-
-// The app's host pointer to the `size` bytes at a device address, where the app has mapped the memory under a live
-// buffer holding all of them; null otherwise (what the device reads there is then not known to the host).
-const unsigned char* MappedBytesAt(const DeviceState& state, VkDeviceAddress address, std::size_t size);
 
 // End of [address, address + size), saturated at 2^64 - 1 (a range that wraps is held by no buffer anyway).
 inline VkDeviceSize SaturatingAdd(VkDeviceSize a, VkDeviceSize b) { return a + b < a ? ~VkDeviceSize{0} : a + b; }

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "buffer_descriptors.h"
 #include "buffer_lookup.h"
 #include "structure_memory.h"
 #include "traced_structures.h"
@@ -44,8 +45,8 @@ std::string Describe(const InFlightBatch& batch, const AsOp& op) {
 
 // The structures an operation names by handle, as f(structure, serial): its source and destination (serial 0: the
 // handle as created before the submission), and for a trace or dispatch (family traces) the structures its bound
-// descriptors name, with the serial each had when written (a set's binding is read now: one that a pending command
-// reads cannot be rewritten before it completes).
+// descriptors name, with the serial each had when written (a set's binding, or a descriptor buffer's bytes, are read
+// now: what a pending command reads cannot be rewritten before it completes).
 template <typename F>
 void ForEachStructure(const CheckContext& ctx, const OpBatch& batch, const AsOp& op, F&& f) {
   if (op.src) f(op.src, uint64_t{0});
@@ -55,6 +56,12 @@ void ForEachStructure(const CheckContext& ctx, const OpBatch& batch, const AsOp&
   for (uint32_t i = 0; i < op.geometry_count; ++i) {
     const TracedBinding& b = bindings[i];
     if (b.source == TracedSource::kPushed && b.pushed && b.pushed_serial) f(b.pushed, b.pushed_serial);
+    if (b.source == TracedSource::kBuffer) {
+      ForEachBufferDescriptor(ctx.state, b.descriptor_address, b.descriptor_count,
+                              [&](BufferDescriptor what, const AccelerationStructureState* s) {
+                                if (what == BufferDescriptor::kStructure) f(s->handle, s->serial);
+                              });
+    }
     if (b.source != TracedSource::kSet) continue;
     ctx.state.ray_bindings.ForEachIn(b.set, b.binding, [&](const DescribedStructure& d) {
       if (d.as && d.serial) f(d.as, d.serial);

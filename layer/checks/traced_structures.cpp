@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "buffer_lookup.h"
+#include "buffer_descriptors.h"
 #include "build_report.h"
 #include "structure_memory.h"
 
@@ -38,40 +38,21 @@ struct TracedJudge {
     return fmt::format("through VkDescriptorSet {} bound at set {}, binding {}", Hex(b.set), b.set_index, b.binding);
   }
 
-  // The descriptors of a binding read from a descriptor buffer: their bytes now, from the app's host mapping of the
-  // memory under the buffer (a valid app wrote them before submitting), turned back into the structure address that
-  // vkGetDescriptorEXT made them from, and that address into the live structure there.
+  // The descriptors of a binding read from a descriptor buffer (buffer_descriptors.h).
   void JudgeBuffer(const TracedBinding& b) const {
-    const std::size_t size = state.ray_bindings.structure_descriptor_size();
-    if (size == 0) return Skip(TracedSkip::kUnreadable);  // no structure descriptor was made through the layer
-    std::shared_ptr<const LiveStructureAddresses> live;
-    for (uint32_t i = 0; i < b.descriptor_count; ++i) {
-      const unsigned char* bytes = MappedBytesAt(state, b.descriptor_address + VkDeviceSize{i} * size, size);
-      if (!bytes) {
-        Skip(TracedSkip::kUnreadable);
-        continue;
-      }
-      VkDeviceAddress address = 0;
-      if (!state.ray_bindings.StructureOfDescriptor(bytes, size, &address)) {
-        Skip(TracedSkip::kUnknownStructure);
-        continue;
-      }
-      if (address == 0) continue;  // a null descriptor: nothing is read
-      if (!live) {
-        live = state.live_structure_addresses.Get(
-            state.acceleration_structures, state.structure_storage_changes.Read(),
-            [&](const AccelerationStructureState& s) { return StorageOfStructure(state, s); },
-            state.failures().structures_incomplete.load(std::memory_order_relaxed));
-      }
-      const std::ptrdiff_t k = live->Find(address);
-      // No live structure there (destroyed since the descriptor was made), or several: which one is not known.
-      if (k < 0 || live->shared[static_cast<std::size_t>(k)]) {
-        Skip(TracedSkip::kUnknownStructure);
-        continue;
-      }
-      const AccelerationStructureState& s = *live->structures[static_cast<std::size_t>(k)];
-      Judge(b, DescribedStructure{s.handle, s.serial});
-    }
+    ForEachBufferDescriptor(state, b.descriptor_address, b.descriptor_count,
+                            [&](BufferDescriptor what, const AccelerationStructureState* s) {
+                              switch (what) {
+                                case BufferDescriptor::kUnreadable:
+                                  return Skip(TracedSkip::kUnreadable);
+                                case BufferDescriptor::kUnknownStructure:
+                                  return Skip(TracedSkip::kUnknownStructure);
+                                case BufferDescriptor::kNull:
+                                  return;
+                                case BufferDescriptor::kStructure:
+                                  return Judge(b, DescribedStructure{s->handle, s->serial});
+                              }
+                            });
   }
 
   void Judge(const TracedBinding& b, const DescribedStructure& d) const {

@@ -4,6 +4,8 @@
 #include <memory>
 #include <mutex>
 
+#include "buffer_descriptors.h"
+
 namespace asval {
 
 namespace {
@@ -88,6 +90,12 @@ void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<I
         for (uint32_t i = 0; i < op.geometry_count; ++i) {
           const TracedBinding& b = bindings[i];
           if (b.source == TracedSource::kPushed) read(b.pushed, b.pushed_serial);
+          if (b.source == TracedSource::kBuffer) {
+            ForEachBufferDescriptor(state, b.descriptor_address, b.descriptor_count,
+                                    [&](BufferDescriptor what, const AccelerationStructureState* s) {
+                                      if (what == BufferDescriptor::kStructure) read(s->handle, s->serial);
+                                    });
+          }
           if (b.source == TracedSource::kSet) {
             state.ray_bindings.ForEachIn(b.set, b.binding, [&](const DescribedStructure& d) { read(d.as, d.serial); });
           }

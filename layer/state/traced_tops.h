@@ -6,8 +6,9 @@
 //
 // Only what is certain is kept: a top level whose latest write, in execution order after this submission, is a
 // build that completed in an earlier submission (its references known) and that no command of this submission
-// writes (the trace read that build). A submission with a batch deferred or of unknown order keeps nothing; nor do
-// structures named only by descriptor-buffer bytes. What is not kept is not judged (a destroy is then silent).
+// writes (the trace read that build). A submission with a batch deferred or of unknown order keeps nothing. Sets,
+// pushed descriptors and descriptor-buffer bytes (read at submission) are followed. What is not kept is not judged
+// (a destroy is then silent).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

@@ -4,10 +4,13 @@
 // each with its valid twin. The host and indirect cases of the other files run there too, as their twins
 // ("@test-driver", run_corpus.py).
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 #include "corpus.h"
 #include "indirect_helpers.h"
+#include "ray_program.h"
+#include "test_driver_api.h"
 
 namespace {
 
@@ -73,6 +76,86 @@ CORPUS_CASE_ON_TEST_DRIVER(IndirectTlasReadsRangeCount, "history-indirect-tlas-r
                            "instance names a destroyed BLAS",
                            {}) {
   BuildOverDestroyedBlas(device, 1);
+}
+
+// Ray-query frames over a top level of one bottom level, the frame's dispatch held pending on the test driver (a busy
+// GPU: the layers above see a submission with no wait, not yet complete) while the host streams a bottom level out.
+class HeldFrames {
+ public:
+  explicit HeldFrames(vkkit::Device& device)
+      : device_(device),
+        hold_(reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
+            vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions))),
+        commands_(device),
+        scene_(device),
+        program_(device, asval_test::RayProgram::Kind::kRayQuery) {
+    if (!hold_) throw std::runtime_error("the test driver's vkAsvalTestDriverHoldSubmissions is missing");
+    Submit([&](VkCommandBuffer cb) { scene_.Build(commands_, cb); });
+    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+    program_.Write(scene_.tlas.handle());
+  }
+  // The top level rebuilt over `blas` alone, waited for.
+  void RebuildOver(asval_test::Blas& blas) {
+    vkkit::Buffer instances = scene_.tlas.MakeInstances({&blas});
+    Submit([&](VkCommandBuffer cb) {
+      blas.Build(cb, asval_test::Shape{});
+      commands_.Barrier(cb);
+      scene_.tlas.Record(cb, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    });
+    vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle");
+    device_.Destroy(instances);
+  }
+  // One frame's dispatch, held pending while `meanwhile` runs on the host, then released and waited for.
+  template <typename F>
+  void FrameWhile(F&& meanwhile) {
+    vkkit::Check(hold_(device_.handle(), VK_TRUE), "vkAsvalTestDriverHoldSubmissions");
+    Submit([&](VkCommandBuffer cb) { program_.Record(cb); });
+    meanwhile();
+    vkkit::Check(hold_(device_.handle(), VK_FALSE), "vkAsvalTestDriverHoldSubmissions");
+    vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle");
+  }
+  asval_test::RayScene& scene() { return scene_; }
+
+ private:
+  template <typename F>
+  void Submit(F&& record) {
+    const VkCommandBuffer cb = commands_.Begin();
+    record(cb);
+    commands_.End(cb);
+    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &cb;
+    vkQueueSubmit(device_.queue(), 1, &submit, VK_NULL_HANDLE);  // a layer that reports it may keep it back
+  }
+
+  vkkit::Device& device_;
+  PFN_vkAsvalTestDriverHoldSubmissions hold_;
+  asval_test::Commands commands_;
+  asval_test::RayScene scene_;
+  asval_test::RayProgram program_;
+};
+
+constexpr const char* kHeld = "held-submissions";
+
+CORPUS_CASE_ON_TEST_DRIVER(TracesBottomLevelDestroyedWhilePending, "traces-bottom-level-destroyed-while-query-pending",
+                           "traces", kHeld,
+                           "a bottom-level structure streamed out (its handle destroyed, its memory kept) while the "
+                           "frame's ray-query dispatch over the top level referencing it is still executing",
+                           {"ASVAL-Traces-BottomLevelInvalid"}) {
+  HeldFrames frames(device);
+  frames.FrameWhile([&] { frames.scene().blas.DestroyHandle(); });
+}
+
+CORPUS_CASE_ON_TEST_DRIVER(TracesBottomLevelStreamedOutSafely,
+                           "traces-bottom-level-streamed-out-while-next-frame-pending", "traces", kHeld,
+                           "streaming: the top level is rebuilt over a new bottom level and waited for, then the next "
+                           "frame's ray-query dispatch is still executing while the old bottom level is destroyed",
+                           {}) {
+  HeldFrames frames(device);
+  asval_test::Blas replacement(device, frames.scene().inputs);
+  frames.FrameWhile([] {});
+  frames.RebuildOver(replacement);
+  frames.FrameWhile([&] { frames.scene().blas.DestroyHandle(); });
 }
 
 }  // namespace

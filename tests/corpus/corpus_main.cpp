@@ -74,14 +74,16 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT seve
 }
 
 // ASVAL_CORPUS_DEVICE_FEATURES: the acceleration-structure features the case's device enables beyond the default,
-// "host-commands" and / or "indirect-build" (run_corpus.py asks for them where the case runs on asval's test
-// driver, which has both: tests/driver).
+// "host-commands", "indirect-build" and / or "held-submissions" (run_corpus.py asks for them where the case runs on
+// asval's test driver, which has both: tests/driver).
 vkkit::DeviceOptions OptionsFromEnvironment() {
   vkkit::DeviceOptions options;
   const char* env = std::getenv("ASVAL_CORPUS_DEVICE_FEATURES");
   const std::string features = env ? env : "";
   options.host_commands = features.find("host-commands") != std::string::npos;
   options.indirect_build = features.find("indirect-build") != std::string::npos;
+  // The test driver's held submissions (tests/driver/submission_hold.h) wait on a timeline semaphore.
+  options.timeline_semaphore = features.find("held-submissions") != std::string::npos;
   return options;
 }
 
@@ -111,7 +113,8 @@ int Run(const Case& c) {
     vkkit::Device device(instance, gpu, OptionsFromEnvironment());
     c.body(device);
   }
-  current_instance = nullptr;  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too
+  current_instance =
+      nullptr;  // the device is destroyed before the messenger: reports made at vkDestroyDevice are printed too
   destroy(instance.handle(), messenger, nullptr);
   return 0;
 }

@@ -5,8 +5,10 @@
 #include <catch2/catch_test_macros.hpp>
 #include <string>
 
+#include "on_test_driver.h"
 #include "ray_program.h"
 #include "temp_report.h"
+#include "test_driver_api.h"
 
 namespace asval_test {
 namespace {
@@ -83,6 +85,70 @@ TEST_CASE("traces: descriptor-buffer bytes that no vkGetDescriptorEXT made are n
         line.find("ASVAL-Traces-Summary") != std::string::npos && line.find("unknown_structure=1") != std::string::npos;
   }
   CHECK(counted);
+}
+
+// A structure a pending descriptor-buffer ray query reads: the top level its bytes name, or the bottom level it
+// traverses through that top level. Destroyed while the query is held pending by the test driver below asval
+// (tests/driver/submission_hold.h), reported and kept back by the layer until the query completed (the monitor's
+// VK_TRUE); or, `pending` false, once the query completed (silent). The bytes are read at the destroy (lifetime) and
+// at the submission (the top levels kept with the batch in flight: traced_tops.h).
+void GoesWhileDescriptorBufferQueryPending(bool pending, bool bottom, const char* id) {
+  OnTestDriver on_test_driver;
+  vkkit::DeviceOptions options = RayDescriptorBufferDevice();
+  options.timeline_semaphore = true;  // the test driver's hold waits on a timeline semaphore
+  HistoryFixture f(id ? "lifetime,traces" : nullptr, {}, options);
+  vkkit::Device& device = f.device();
+  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
+      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
+  REQUIRE(hold != nullptr);
+  RayScene scene(device);
+  DescriptorBufferRayQuery program(device);
+  Commands commands(device);
+  REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
+  program.Write(scene.tlas.address());
+  const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  if (pending) REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
+  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
+  if (!pending) REQUIRE(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  if (id) f.monitor().Expect(id);
+  if (bottom) {
+    scene.blas.DestroyHandle();
+  } else {
+    scene.tlas.DestroyHandle();
+  }
+  CHECK(f.monitor().Verify() == "");
+  if (pending) {
+    CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
+    CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  }
+  CHECK(program.hit() == 1);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE(
+    "lifetime: a top-level structure destroyed while a pending ray query reads it through a descriptor buffer is "
+    "reported (accelerationStructure-02442)",
+    "[integration][lifetime][traces]") {
+  GoesWhileDescriptorBufferQueryPending(true, false,
+                                        "VUID-vkDestroyAccelerationStructureKHR-accelerationStructure-02442");
+}
+
+TEST_CASE(
+    "traces: a bottom level destroyed while a pending ray query traverses it through a top level named by "
+    "descriptor-buffer bytes is reported (ASVAL-Traces-BottomLevelInvalid)",
+    "[integration][lifetime][traces]") {
+  GoesWhileDescriptorBufferQueryPending(true, true, "ASVAL-Traces-BottomLevelInvalid");
+}
+
+TEST_CASE(
+    "lifetime valid twin: the top level and the bottom level a descriptor-buffer ray query read, destroyed once it "
+    "completed, stay silent",
+    "[integration][lifetime][traces]") {
+  GoesWhileDescriptorBufferQueryPending(false, false, nullptr);
+  GoesWhileDescriptorBufferQueryPending(false, true, nullptr);
 }
 
 }  // namespace
