@@ -1,6 +1,7 @@
 #include "traced_tops.h"
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <mutex>
 
@@ -53,6 +54,49 @@ class WrittenIn {
 };
 thread_local std::vector<VkAccelerationStructureKHR> WrittenIn::written_;
 
+// The bindings a batch's traces read already: a frame's dispatches bind the same set again and again, and each
+// (source, set or structure or address, binding or serial or count) names the same structures (sets and descriptor
+// bytes are read now) and so the same top levels. A few kept, the oldest replaced.
+class SeenBindings {
+ public:
+  // Whether `b` was seen; remembers it.
+  bool Seen(const TracedBinding& b) {
+    Key key{b.source, 0, 0};
+    switch (b.source) {
+      case TracedSource::kSet:
+        key.object = reinterpret_cast<uint64_t>(b.set);
+        key.detail = b.binding;
+        break;
+      case TracedSource::kPushed:
+        key.object = reinterpret_cast<uint64_t>(b.pushed);
+        key.detail = b.pushed_serial;
+        break;
+      case TracedSource::kBuffer:
+        key.object = b.descriptor_address;
+        key.detail = b.descriptor_count;
+        break;
+      default:
+        return true;  // reads nothing the layer follows
+    }
+    for (std::size_t k = 0; k < count_; ++k) {
+      if (keys_[k] == key) return true;
+    }
+    keys_[next_] = key;
+    next_ = (next_ + 1) % keys_.size();
+    if (count_ < keys_.size()) ++count_;
+    return false;
+  }
+
+ private:
+  struct Key {
+    TracedSource source;
+    uint64_t object, detail;
+    bool operator==(const Key& o) const { return source == o.source && object == o.object && detail == o.detail; }
+  };
+  std::array<Key, 8> keys_{};
+  std::size_t next_ = 0, count_ = 0;
+};
+
 }  // namespace
 
 void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<InFlightBatch>& staged,
@@ -63,6 +107,7 @@ void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<I
   WrittenIn written(staged, first);
   for (std::size_t k = first; k < staged.size(); ++k) {
     InFlightBatch& batch = staged[k];
+    SeenBindings seen;
     for (const std::shared_ptr<const RecordedOps>& recorded : batch.recorded) {
       if (!recorded || recorded->batch.traced().size() == 0) continue;
       for (const AsOp& op : recorded->batch.ops()) {
@@ -89,6 +134,7 @@ void NoteTracedTops(const DeviceState& state, uint64_t submission, std::vector<I
         const TracedBinding* bindings = recorded->batch.traced().begin() + op.first_geometry;
         for (uint32_t i = 0; i < op.geometry_count; ++i) {
           const TracedBinding& b = bindings[i];
+          if (seen.Seen(b)) continue;
           if (b.source == TracedSource::kPushed) read(b.pushed, b.pushed_serial);
           if (b.source == TracedSource::kBuffer) {
             ForEachBufferDescriptor(state, b.descriptor_address, b.descriptor_count,
