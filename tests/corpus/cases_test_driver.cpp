@@ -4,13 +4,12 @@
 // each with its valid twin. The host and indirect cases of the other files run there too, as their twins
 // ("@test-driver", run_corpus.py).
 #include <cstring>
-#include <stdexcept>
 #include <vector>
 
 #include "corpus.h"
 #include "indirect_helpers.h"
+#include "on_test_driver.h"
 #include "ray_program.h"
-#include "test_driver_api.h"
 
 namespace {
 
@@ -84,52 +83,43 @@ class HeldFrames {
  public:
   explicit HeldFrames(vkkit::Device& device)
       : device_(device),
-        hold_(reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
-            vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions))),
+        held_(device),
         commands_(device),
         scene_(device),
         program_(device, asval_test::RayProgram::Kind::kRayQuery) {
-    if (!hold_) throw std::runtime_error("the test driver's vkAsvalTestDriverHoldSubmissions is missing");
-    Submit([&](VkCommandBuffer cb) { scene_.Build(commands_, cb); });
-    vkkit::Check(vkQueueWaitIdle(device.queue()), "vkQueueWaitIdle");
+    held_.SubmitAndWait(Recorded([&](VkCommandBuffer cb) { scene_.Build(commands_, cb); }));
     program_.Write(scene_.tlas.handle());
   }
   // The top level rebuilt over `blas` alone, waited for.
   void RebuildOver(asval_test::Blas& blas) {
     vkkit::Buffer instances = scene_.tlas.MakeInstances({&blas});
-    Submit([&](VkCommandBuffer cb) {
+    held_.SubmitAndWait(Recorded([&](VkCommandBuffer cb) {
       blas.Build(cb, asval_test::Shape{});
       commands_.Barrier(cb);
       scene_.tlas.Record(cb, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-    });
-    vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle");
+    }));
     device_.Destroy(instances);
   }
   // One frame's dispatch, held pending while `meanwhile` runs on the host, then released and waited for.
   template <typename F>
   void FrameWhile(F&& meanwhile) {
-    vkkit::Check(hold_(device_.handle(), VK_TRUE), "vkAsvalTestDriverHoldSubmissions");
-    Submit([&](VkCommandBuffer cb) { program_.Record(cb); });
+    held_.SubmitHeld(Recorded([&](VkCommandBuffer cb) { program_.Record(cb); }));  // may be kept back: not checked
     meanwhile();
-    vkkit::Check(hold_(device_.handle(), VK_FALSE), "vkAsvalTestDriverHoldSubmissions");
-    vkkit::Check(vkQueueWaitIdle(device_.queue()), "vkQueueWaitIdle");
+    vkkit::Check(held_.Release(), "vkAsvalTestDriverHoldSubmissions");
   }
   asval_test::RayScene& scene() { return scene_; }
 
  private:
   template <typename F>
-  void Submit(F&& record) {
+  VkCommandBuffer Recorded(F&& record) {
     const VkCommandBuffer cb = commands_.Begin();
     record(cb);
     commands_.End(cb);
-    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &cb;
-    vkQueueSubmit(device_.queue(), 1, &submit, VK_NULL_HANDLE);  // a layer that reports it may keep it back
+    return cb;
   }
 
   vkkit::Device& device_;
-  PFN_vkAsvalTestDriverHoldSubmissions hold_;
+  asval_test::HeldSubmissions held_;
   asval_test::Commands commands_;
   asval_test::RayScene scene_;
   asval_test::RayProgram program_;

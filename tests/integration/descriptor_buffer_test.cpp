@@ -8,7 +8,6 @@
 #include "on_test_driver.h"
 #include "ray_program.h"
 #include "temp_report.h"
-#include "test_driver_api.h"
 
 namespace asval_test {
 namespace {
@@ -98,21 +97,14 @@ void GoesWhileDescriptorBufferQueryPending(bool pending, bool bottom, const char
   options.timeline_semaphore = true;  // the test driver's hold waits on a timeline semaphore
   HistoryFixture f(id ? "lifetime,traces" : nullptr, {}, options);
   vkkit::Device& device = f.device();
-  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
-      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
-  REQUIRE(hold != nullptr);
+  HeldSubmissions held(device);
   RayScene scene(device);
   DescriptorBufferRayQuery program(device);
   Commands commands(device);
   REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
   program.Write(scene.tlas.address());
   const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  if (pending) REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
-  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
-  if (!pending) REQUIRE(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  REQUIRE((pending ? held.SubmitHeld(cb) : held.SubmitAndWait(cb)) == VK_SUCCESS);
   if (id) f.monitor().Expect(id);
   if (bottom) {
     scene.blas.DestroyHandle();
@@ -120,10 +112,7 @@ void GoesWhileDescriptorBufferQueryPending(bool pending, bool bottom, const char
     scene.tlas.DestroyHandle();
   }
   CHECK(f.monitor().Verify() == "");
-  if (pending) {
-    CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
-    CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
-  }
+  CHECK(held.Release() == VK_SUCCESS);
   CHECK(program.hit() == 1);
   CHECK(f.monitor().Verify() == "");
 }

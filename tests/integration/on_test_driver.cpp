@@ -1,11 +1,54 @@
 #include "on_test_driver.h"
 
+#include <stdexcept>
+
 namespace asval_test {
 
 std::string LayersWithTestDriver() {
   std::string list;
   for (const std::string& layer : vkkit::LayersFromEnvironment()) list += layer + ":";
   return list + "VK_LAYER_ASVAL_test_driver";
+}
+
+HeldSubmissions::HeldSubmissions(vkkit::Device& device)
+    : device_(device),
+      hold_(reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
+          vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions))) {
+  if (!hold_) throw std::runtime_error("vkAsvalTestDriverHoldSubmissions: the test driver is not below the layers");
+}
+
+HeldSubmissions::~HeldSubmissions() {
+  if (held_) Release();
+}
+
+VkResult HeldSubmissions::Submit(VkCommandBuffer cb) {
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cb;
+  return vkQueueSubmit(device_.queue(), 1, &submit, VK_NULL_HANDLE);
+}
+
+VkResult HeldSubmissions::SubmitHeld(VkCommandBuffer cb) {
+  if (!held_) {
+    const VkResult held = hold_(device_.handle(), VK_TRUE);
+    if (held != VK_SUCCESS) return held;
+    held_ = true;
+  }
+  return Submit(cb);
+}
+
+VkResult HeldSubmissions::Release() {
+  if (held_) {
+    held_ = false;
+    const VkResult released = hold_(device_.handle(), VK_FALSE);
+    if (released != VK_SUCCESS) return released;
+  }
+  return vkQueueWaitIdle(device_.queue());
+}
+
+VkResult HeldSubmissions::SubmitAndWait(VkCommandBuffer cb) {
+  const VkResult submitted = Submit(cb);
+  return submitted != VK_SUCCESS ? submitted : vkQueueWaitIdle(device_.queue());
 }
 
 DeviceLocalStructure::DeviceLocalStructure(vkkit::Device& device, VkAccelerationStructureTypeKHR type,

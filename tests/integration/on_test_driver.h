@@ -5,6 +5,7 @@
 #include <string>
 
 #include "scoped_env.h"
+#include "test_driver_api.h"
 #include "vkkit.h"
 
 namespace asval_test {
@@ -24,6 +25,30 @@ class OnTestDriver {
 
  private:
   ScopedEnvironment layers_;
+};
+
+// The test driver's held submissions (tests/driver/test_driver_api.h): work the layers above see submitted with no
+// wait (asval applies it at once, as on a busy GPU), pending until Release. The device enables timelineSemaphore.
+class HeldSubmissions {
+ public:
+  explicit HeldSubmissions(vkkit::Device& device);  // throws when the test driver is not below the layers
+  ~HeldSubmissions();                               // releases what is still held
+  HeldSubmissions(const HeldSubmissions&) = delete;
+  HeldSubmissions& operator=(const HeldSubmissions&) = delete;
+
+  // Submits `cb` (no semaphore, no fence), held pending.
+  VkResult SubmitHeld(VkCommandBuffer cb);
+  // Lets the held work run, and waits for the queue.
+  VkResult Release();
+  // Submits `cb` (no semaphore, no fence) and waits for the queue: it completed.
+  VkResult SubmitAndWait(VkCommandBuffer cb);
+
+ private:
+  VkResult Submit(VkCommandBuffer cb);
+
+  vkkit::Device& device_;
+  PFN_vkAsvalTestDriverHoldSubmissions hold_ = nullptr;
+  bool held_ = false;
 };
 
 // A structure on a buffer bound to device-local memory that is not host-visible (the test driver's added memory

@@ -7,7 +7,6 @@
 #include "on_test_driver.h"
 #include "ray_program.h"
 #include "temp_report.h"
-#include "test_driver_api.h"
 
 namespace asval_test {
 namespace {
@@ -487,9 +486,7 @@ void BottomLevelGoesWhileQueryPending(bool pending, bool rebuilt, const std::fun
   OnTestDriver on_test_driver;
   HistoryFixture f(id ? "lifetime,traces" : nullptr, {}, RayTimelineDevice());
   vkkit::Device& device = f.device();
-  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
-      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
-  REQUIRE(hold != nullptr);
+  HeldSubmissions held(device);
   Commands commands(device);
   RayScene scene(device);
   REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) { scene.Build(commands, c); })) == VK_SUCCESS);
@@ -497,28 +494,20 @@ void BottomLevelGoesWhileQueryPending(bool pending, bool rebuilt, const std::fun
   if (rebuilt) {
     vkkit::Buffer instances = scene.tlas.MakeInstances({&replacement});
     REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-              replacement.Build(c, Shape{});
-              commands.Barrier(c);
-              scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-            })) == VK_SUCCESS);
+      replacement.Build(c, Shape{});
+      commands.Barrier(c);
+      scene.tlas.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+    })) == VK_SUCCESS);
     device.Destroy(instances);
   }
   RayProgram program(device, RayProgram::Kind::kRayQuery);
   program.Write(scene.tlas.handle());
   const VkCommandBuffer cb = Recorded(commands, [&](VkCommandBuffer c) { program.Record(c); });
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  if (pending) REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
-  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
-  if (!pending) REQUIRE(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  REQUIRE((pending ? held.SubmitHeld(cb) : held.SubmitAndWait(cb)) == VK_SUCCESS);
   if (id) f.monitor().Expect(id);
   goes(scene.blas);
   CHECK(f.monitor().Verify() == "");
-  if (pending) {
-    CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
-    CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
-  }
+  CHECK(held.Release() == VK_SUCCESS);
   CHECK(program.hit() == 1u);
   CHECK(f.monitor().Verify() == "");
 }
@@ -563,20 +552,18 @@ TEST_CASE(
   OnTestDriver on_test_driver;
   HistoryFixture f(nullptr, {}, RayTimelineDevice());
   vkkit::Device& device = f.device();
-  const auto hold = reinterpret_cast<PFN_vkAsvalTestDriverHoldSubmissions>(
-      vkGetDeviceProcAddr(device.handle(), kAsvalTestDriverHoldSubmissions));
-  REQUIRE(hold != nullptr);
+  HeldSubmissions held(device);
   Commands commands(device);
   RayScene scene(device);
   Blas replacement(device, scene.inputs);
   Tlas other(device);
   vkkit::Buffer instances = other.MakeInstances({&replacement});
   REQUIRE(commands.Submit(Recorded(commands, [&](VkCommandBuffer c) {
-            scene.Build(commands, c);
-            replacement.Build(c, Shape{});
-            commands.Barrier(c);
-            other.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
-          })) == VK_SUCCESS);
+    scene.Build(commands, c);
+    replacement.Build(c, Shape{});
+    commands.Barrier(c);
+    other.Record(c, instances, 1, VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR);
+  })) == VK_SUCCESS);
   RayProgram program(device, RayProgram::Kind::kRayQuery);
   program.Write(scene.tlas.handle());
   // The query reads the top level referencing scene.blas; the clone then makes it reference `replacement`.
@@ -585,15 +572,10 @@ TEST_CASE(
     commands.Barrier(c);
     CmdCopy(device, c, other.handle(), scene.tlas.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
   });
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cb;
-  REQUIRE(hold(device.handle(), VK_TRUE) == VK_SUCCESS);
-  REQUIRE(vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE) == VK_SUCCESS);
+  REQUIRE(held.SubmitHeld(cb) == VK_SUCCESS);
   replacement.DestroyHandle();  // what the clone's source references: not what the query traverses
   CHECK(f.monitor().Verify() == "");
-  CHECK(hold(device.handle(), VK_FALSE) == VK_SUCCESS);
-  CHECK(vkQueueWaitIdle(device.queue()) == VK_SUCCESS);
+  CHECK(held.Release() == VK_SUCCESS);
   CHECK(program.hit() == 1u);
   device.Destroy(instances);
   CHECK(f.monitor().Verify() == "");
