@@ -6,6 +6,7 @@
 #include "device_buffers.h"
 #include "device_executor.h"
 #include "indirect_builds.h"
+#include "nv_ray_tracing.h"
 
 namespace asval_test_driver {
 namespace {

@@ -15,6 +15,7 @@ class DeviceExecutor;
 class DeferredOperations;
 class DeviceBuffers;
 class IndirectBuilds;
+class NvRayTracing;
 
 struct InstanceData {
   VkInstance instance = VK_NULL_HANDLE;
@@ -30,6 +31,7 @@ struct InstanceData {
   PFN_vkGetPhysicalDeviceProperties2 GetPhysicalDeviceProperties2 = nullptr;
   PFN_vkGetPhysicalDeviceProperties2KHR GetPhysicalDeviceProperties2KHR = nullptr;
   PFN_vkCreateDevice CreateDevice = nullptr;
+  PFN_vkEnumerateDeviceExtensionProperties EnumerateDeviceExtensionProperties = nullptr;
 };
 
 // The device functions below the test driver that it calls itself.
@@ -68,7 +70,8 @@ struct DeviceData {
   std::unique_ptr<DeferredOperations> deferred;
   std::unique_ptr<DeviceBuffers> buffers;
   std::unique_ptr<IndirectBuilds> indirect;
-  SubmissionHold hold;  // under queue_lock (submission_hold.h)
+  std::unique_ptr<NvRayTracing> nv;  // VK_NV_ray_tracing's structures (nv_ray_tracing.h)
+  SubmissionHold hold;               // under queue_lock (submission_hold.h)
 };
 
 void* DispatchKey(const void* handle);

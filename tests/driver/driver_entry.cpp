@@ -1,6 +1,6 @@
-// The test driver's entry points: the loader's layer interface, instance and device creation (the features it
-// adds are reported to the layers above and taken out of what reaches the driver below), and the commands it
-// executes itself. Everything else goes down the chain unchanged.
+// The test driver's entry points: the loader's layer interface, instance and device creation (the features and
+// extensions it adds are reported to the layers above and taken out of what reaches the driver below), and the
+// commands it executes itself. Everything else goes down the chain unchanged.
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -13,6 +13,7 @@
 #include "host_commands.h"
 #include "indirect_builds.h"
 #include "memory_types.h"
+#include "nv_ray_tracing.h"
 
 #define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
 
@@ -75,9 +76,19 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties(VkPhysicalDevice gpu, VkP
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2(VkPhysicalDevice gpu, VkPhysicalDeviceProperties2* properties) {
   InstanceData* instance = InstanceOf(gpu);
+  const RayTracingPropertiesNV nv(properties);
   (instance->GetPhysicalDeviceProperties2 ? instance->GetPhysicalDeviceProperties2
                                           : instance->GetPhysicalDeviceProperties2KHR)(gpu, properties);
   ReportDeviceType(&properties->properties);
+}
+
+// The device's extensions with those the test driver adds (nv_ray_tracing.h). A layer's name goes down the chain: the
+// loader answers the application's from the manifests.
+VKAPI_ATTR VkResult VKAPI_CALL EnumerateDeviceExtensionProperties(VkPhysicalDevice gpu, const char* layer,
+                                                                  uint32_t* count, VkExtensionProperties* properties) {
+  InstanceData* instance = InstanceOf(gpu);
+  if (layer != nullptr) return instance->EnumerateDeviceExtensionProperties(gpu, layer, count, properties);
+  return EnumerateDeviceExtensionsWithNv(instance->EnumerateDeviceExtensionProperties, gpu, count, properties);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL EnumeratePhysicalDevices(VkInstance handle, uint32_t* count, VkPhysicalDevice* gpus) {
@@ -116,6 +127,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateInstance(const VkInstanceCreateInfo* info, 
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceProperties2);
   ASVAL_DRIVER_LOAD(GetPhysicalDeviceProperties2KHR);
   ASVAL_DRIVER_LOAD(CreateDevice);
+  ASVAL_DRIVER_LOAD(EnumerateDeviceExtensionProperties);
 #undef ASVAL_DRIVER_LOAD
   return VK_SUCCESS;
 }
@@ -169,10 +181,11 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   const PFN_vkGetDeviceProcAddr next_gdpa = link->u.pLayerInfo->pfnNextGetDeviceProcAddr;
   link->u.pLayerInfo = link->u.pLayerInfo->pNext;
   auto create = reinterpret_cast<PFN_vkCreateDevice>(next_gipa(instance->instance, "vkCreateDevice"));
+  const DeviceCreateWithoutNv without_nv(*info);
   VkResult result;
   {
     const HiddenFeatures hidden(info->pNext);
-    result = create(gpu, info, allocator, out);
+    result = create(gpu, without_nv.below(), allocator, out);
   }
   if (result != VK_SUCCESS) return result;
   DeviceData* device = AddDevice(*out);
@@ -186,6 +199,11 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   device->deferred = std::make_unique<DeferredOperations>();
   device->buffers = std::make_unique<DeviceBuffers>();
   device->indirect = std::make_unique<IndirectBuilds>(*device);
+  VkPhysicalDeviceMemoryProperties above = device->memory;  // the NV structures may live in any type the app sees
+  AddMemoryType(&above);
+  const uint32_t every_type = above.memoryTypeCount >= 32 ? ~0u : (1u << above.memoryTypeCount) - 1;
+  device->nv =
+      std::make_unique<NvRayTracing>(without_nv.nv_enabled(), without_nv.ray_tracing_pipeline_enabled(), every_type);
   return VK_SUCCESS;
 }
 
@@ -254,7 +272,9 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
 VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice handle, const VkBufferCreateInfo* info,
                                             const VkAllocationCallbacks* allocator, VkBuffer* buffer) {
   DeviceData* device = FindDevice(handle);
-  const VkResult result = device->vk.CreateBuffer(handle, info, allocator, buffer);
+  VkBufferCreateInfo below = *info;
+  below.usage = device->nv->UsageBelow(info->usage);
+  const VkResult result = device->vk.CreateBuffer(handle, &below, allocator, buffer);
   if (result == VK_SUCCESS) device->buffers->Created(*buffer, *info);
   return result;
 }
@@ -450,6 +470,7 @@ PFN_vkVoidFunction InstanceFunction(const char* name) {
     return reinterpret_cast<PFN_vkVoidFunction>(&GetPhysicalDeviceProperties2);
   }
   ASVAL_DRIVER_HOOK(CreateDevice)
+  ASVAL_DRIVER_HOOK(EnumerateDeviceExtensionProperties)
 #undef ASVAL_DRIVER_HOOK
   return nullptr;
 }
@@ -460,7 +481,12 @@ PFN_vkVoidFunction GetDeviceProcAddr(VkDevice handle, const char* name) {
   if (std::strcmp(name, "vkGetDeviceProcAddr") == 0) return reinterpret_cast<PFN_vkVoidFunction>(&GetDeviceProcAddr);
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
   DeviceData* device = handle != VK_NULL_HANDLE ? FindDevice(handle) : nullptr;
-  return device != nullptr ? device->next_gdpa(handle, name) : nullptr;
+  if (device == nullptr) return nullptr;
+  // VK_NV_ray_tracing's commands only where it is enabled: elsewhere the device is the driver below's.
+  if (device->nv->enabled()) {
+    if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;
+  }
+  return device->next_gdpa(handle, name);
 }
 
 PFN_vkVoidFunction GetInstanceProcAddr(VkInstance handle, const char* name) {
@@ -471,6 +497,7 @@ PFN_vkVoidFunction GetInstanceProcAddr(VkInstance handle, const char* name) {
   if (PFN_vkVoidFunction own = InstanceFunction(name)) return own;
   if (handle == VK_NULL_HANDLE) return nullptr;
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
+  if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;  // for any device: none is named here
   InstanceData* instance = FindInstance(handle);
   return instance != nullptr ? instance->next_gipa(handle, name) : nullptr;
 }

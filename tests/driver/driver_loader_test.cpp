@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "test_driver_api.h"
 #include "vkkit.h"
 
 namespace {
@@ -327,6 +328,258 @@ TEST_CASE("test driver: says it is an integrated GPU when ASVAL_TEST_DRIVER_DEVI
   setenv("ASVAL_TEST_DRIVER_DEVICE_TYPE", "integrated-gpu", 1);
   CHECK(type() == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU);
   unsetenv("ASVAL_TEST_DRIVER_DEVICE_TYPE");
+}
+
+}  // namespace
+
+namespace {
+
+// VK_NV_ray_tracing's entry points, as a device that enables it gets them.
+struct NvFunctions {
+  explicit NvFunctions(VkDevice vk)
+      : Create(Load<PFN_vkCreateAccelerationStructureNV>(vk, "vkCreateAccelerationStructureNV")),
+        Destroy(Load<PFN_vkDestroyAccelerationStructureNV>(vk, "vkDestroyAccelerationStructureNV")),
+        Requirements(Load<PFN_vkGetAccelerationStructureMemoryRequirementsNV>(
+            vk, "vkGetAccelerationStructureMemoryRequirementsNV")),
+        Bind(Load<PFN_vkBindAccelerationStructureMemoryNV>(vk, "vkBindAccelerationStructureMemoryNV")),
+        Handle(Load<PFN_vkGetAccelerationStructureHandleNV>(vk, "vkGetAccelerationStructureHandleNV")),
+        CmdBuild(Load<PFN_vkCmdBuildAccelerationStructureNV>(vk, "vkCmdBuildAccelerationStructureNV")),
+        CmdCopy(Load<PFN_vkCmdCopyAccelerationStructureNV>(vk, "vkCmdCopyAccelerationStructureNV")),
+        CmdWriteProperties(Load<PFN_vkCmdWriteAccelerationStructuresPropertiesNV>(
+            vk, "vkCmdWriteAccelerationStructuresPropertiesNV")) {}
+  PFN_vkCreateAccelerationStructureNV Create;
+  PFN_vkDestroyAccelerationStructureNV Destroy;
+  PFN_vkGetAccelerationStructureMemoryRequirementsNV Requirements;
+  PFN_vkBindAccelerationStructureMemoryNV Bind;
+  PFN_vkGetAccelerationStructureHandleNV Handle;
+  PFN_vkCmdBuildAccelerationStructureNV CmdBuild;
+  PFN_vkCmdCopyAccelerationStructureNV CmdCopy;
+  PFN_vkCmdWriteAccelerationStructuresPropertiesNV CmdWriteProperties;
+};
+
+std::vector<VkExtensionProperties> DeviceExtensions(VkPhysicalDevice gpu) {
+  uint32_t count = 0;
+  REQUIRE(vkEnumerateDeviceExtensionProperties(gpu, nullptr, &count, nullptr) == VK_SUCCESS);
+  std::vector<VkExtensionProperties> extensions(count);
+  REQUIRE(vkEnumerateDeviceExtensionProperties(gpu, nullptr, &count, extensions.data()) == VK_SUCCESS);
+  extensions.resize(count);
+  return extensions;
+}
+
+TEST_CASE("test driver: lists VK_NV_ray_tracing and reports its properties; a device without it is unchanged") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  const auto extensions = DeviceExtensions(gpu);
+  uint32_t listed = 0;
+  for (const VkExtensionProperties& e : extensions) {
+    if (std::strcmp(e.extensionName, VK_NV_RAY_TRACING_EXTENSION_NAME) != 0) continue;
+    ++listed;
+    CHECK(e.specVersion == 3);
+  }
+  CHECK(listed == 1);
+  // One short: VK_INCOMPLETE, with as many written as asked.
+  uint32_t fewer = static_cast<uint32_t>(extensions.size()) - 1;
+  std::vector<VkExtensionProperties> some(fewer);
+  CHECK(vkEnumerateDeviceExtensionProperties(gpu, nullptr, &fewer, some.data()) == VK_INCOMPLETE);
+  CHECK(fewer == extensions.size() - 1);
+
+  // The NV properties between two structures the driver below fills: the chain stays whole.
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+  VkPhysicalDeviceRayTracingPropertiesNV nv{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PROPERTIES_NV, &as};
+  VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &nv};
+  vkGetPhysicalDeviceProperties2(gpu, &properties);
+  CHECK(properties.pNext == &nv);
+  CHECK(nv.pNext == &as);
+  CHECK(as.maxGeometryCount != 0);
+  CHECK(nv.maxGeometryCount == 64);
+  CHECK(nv.maxGeometryCount == kAsvalTestDriverNvMaxGeometryCount);
+  CHECK(nv.shaderGroupHandleSize == 32);
+  CHECK(nv.maxRecursionDepth == 31);
+  CHECK(nv.maxShaderGroupStride == 4096);
+  CHECK(nv.shaderGroupBaseAlignment == 64);
+  CHECK(nv.maxInstanceCount == uint64_t{1} << 24);
+  CHECK(nv.maxTriangleCount == uint64_t{1} << 29);
+  CHECK(nv.maxDescriptorSetAccelerationStructures == 16);
+
+  // A device that does not enable it has none of its commands.
+  DriverDevice d;
+  CHECK(vkGetDeviceProcAddr(d.vk, "vkCreateAccelerationStructureNV") == nullptr);
+  CHECK(vkGetDeviceProcAddr(d.vk, "vkCmdBuildAccelerationStructureNV") == nullptr);
+}
+
+TEST_CASE("test driver: VK_NV_ray_tracing structures are created, sized, bound and handled; their commands submitted") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  vkkit::DeviceOptions options;
+  options.extensions = {VK_NV_RAY_TRACING_EXTENSION_NAME};
+  vkkit::Device device(instance, gpu, options);  // throws if the device cannot be created
+  const VkDevice vk = device.handle();
+  const NvFunctions nv(vk);
+  REQUIRE(nv.Create != nullptr);
+  REQUIRE(nv.Destroy != nullptr);
+  REQUIRE(nv.Requirements != nullptr);
+  REQUIRE(nv.Bind != nullptr);
+  REQUIRE(nv.Handle != nullptr);
+  REQUIRE(nv.CmdBuild != nullptr);
+  REQUIRE(nv.CmdCopy != nullptr);
+  REQUIRE(nv.CmdWriteProperties != nullptr);
+
+  // Three indexed triangles over five vertices (sized by their indices: 9 / 3), one instance of them, the bottom
+  // level's clone, and a compacted structure.
+  const float vertices[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 2, 0};
+  const uint32_t indices[9] = {0, 1, 2, 1, 3, 2, 2, 3, 4};
+  // RAY_TRACING_BIT_NV (SHADER_BINDING_TABLE_BIT_KHR) on a device without VK_KHR_ray_tracing_pipeline.
+  auto geometry_data = device.CreateBuffer(sizeof(vertices) + sizeof(indices), VK_BUFFER_USAGE_RAY_TRACING_BIT_NV);
+  std::memcpy(geometry_data.mapped, vertices, sizeof(vertices));
+  std::memcpy(static_cast<char*>(geometry_data.mapped) + sizeof(vertices), indices, sizeof(indices));
+  VkGeometryNV geometry{VK_STRUCTURE_TYPE_GEOMETRY_NV};
+  geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_NV;
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_NV;
+  auto& t = geometry.geometry.triangles;
+  t.sType = VK_STRUCTURE_TYPE_GEOMETRY_TRIANGLES_NV;
+  t.vertexData = geometry_data.buffer;
+  t.vertexCount = 5;
+  t.vertexStride = 12;
+  t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  t.indexData = geometry_data.buffer;
+  t.indexOffset = sizeof(vertices);
+  t.indexCount = 9;
+  t.indexType = VK_INDEX_TYPE_UINT32;
+  geometry.geometry.aabbs.sType = VK_STRUCTURE_TYPE_GEOMETRY_AABB_NV;
+  VkAccelerationStructureInfoNV bottom_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_INFO_NV};
+  bottom_info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_NV;
+  bottom_info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_NV;
+  bottom_info.geometryCount = 1;
+  bottom_info.pGeometries = &geometry;
+  VkAccelerationStructureInfoNV top_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_INFO_NV};
+  top_info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_NV;
+  top_info.instanceCount = 1;
+  VkAccelerationStructureInfoNV compacted_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_INFO_NV};
+  compacted_info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_NV;
+
+  const auto create = [&](const VkAccelerationStructureInfoNV& info, VkDeviceSize compacted_size) {
+    VkAccelerationStructureCreateInfoNV create_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_NV};
+    create_info.compactedSize = compacted_size;
+    create_info.info = info;
+    VkAccelerationStructureNV structure = VK_NULL_HANDLE;
+    REQUIRE(nv.Create(vk, &create_info, nullptr, &structure) == VK_SUCCESS);
+    REQUIRE(structure != VK_NULL_HANDLE);
+    return structure;
+  };
+  const VkAccelerationStructureNV bottom = create(bottom_info, 0);
+  const VkAccelerationStructureNV top = create(top_info, 0);
+  const VkAccelerationStructureNV clone = create(bottom_info, 0);
+  const VkAccelerationStructureNV compacted = create(compacted_info, 1000);
+  const VkAccelerationStructureNV structures[] = {bottom, top, clone, compacted};
+
+  const auto requirements = [&](VkAccelerationStructureNV structure,
+                                VkAccelerationStructureMemoryRequirementsTypeNV type) {
+    VkAccelerationStructureMemoryRequirementsInfoNV info{
+        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_INFO_NV};
+    info.type = type;
+    info.accelerationStructure = structure;
+    VkMemoryRequirements2 out{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2};
+    nv.Requirements(vk, &info, &out);
+    return out.memoryRequirements;
+  };
+  constexpr auto kObject = VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_OBJECT_NV;
+  constexpr auto kBuild = VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_BUILD_SCRATCH_NV;
+  constexpr auto kUpdate = VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_UPDATE_SCRATCH_NV;
+  // By hand: OBJECT 1024 + 128 P up to a multiple of 256, BUILD_SCRATCH 512 + 64 P, UPDATE_SCRATCH 256 + 32 P; a
+  // compacted structure's OBJECT its compacted size up to a multiple of 256, its scratch that of P = 0.
+  CHECK(requirements(bottom, kObject).size == 1536);  // P = 3: 1024 + 384 = 1408
+  CHECK(requirements(bottom, kBuild).size == 704);
+  CHECK(requirements(bottom, kUpdate).size == 352);
+  CHECK(requirements(top, kObject).size == 1280);  // P = 1: 1024 + 128 = 1152
+  CHECK(requirements(top, kBuild).size == 576);
+  CHECK(requirements(top, kUpdate).size == 288);
+  CHECK(requirements(compacted, kObject).size == 1024);
+  CHECK(requirements(compacted, kBuild).size == 512);
+  CHECK(requirements(compacted, kUpdate).size == 256);
+  VkPhysicalDeviceMemoryProperties memory_properties{};
+  vkGetPhysicalDeviceMemoryProperties(gpu, &memory_properties);
+  const uint32_t every_type = (1u << memory_properties.memoryTypeCount) - 1;
+  for (const VkAccelerationStructureNV structure : structures) {
+    for (const auto type : {kObject, kBuild, kUpdate}) {
+      const VkMemoryRequirements r = requirements(structure, type);
+      CHECK(r.alignment == 256);
+      CHECK(r.memoryTypeBits == every_type);
+    }
+  }
+
+  // One allocation, each structure's OBJECT memory 2048 bytes apart (every OBJECT size here is at most 1536).
+  VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  allocate.allocationSize = 4 * 2048;
+  allocate.memoryTypeIndex = 0;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  REQUIRE(vkAllocateMemory(vk, &allocate, nullptr, &memory) == VK_SUCCESS);
+  std::vector<VkBindAccelerationStructureMemoryInfoNV> binds;
+  for (const VkAccelerationStructureNV structure : structures) {
+    VkBindAccelerationStructureMemoryInfoNV bind{VK_STRUCTURE_TYPE_BIND_ACCELERATION_STRUCTURE_MEMORY_INFO_NV};
+    bind.accelerationStructure = structure;
+    bind.memory = memory;
+    bind.memoryOffset = 2048 * binds.size();
+    binds.push_back(bind);
+  }
+  REQUIRE(nv.Bind(vk, static_cast<uint32_t>(binds.size()), binds.data()) == VK_SUCCESS);
+
+  std::vector<uint64_t> handles;
+  for (const VkAccelerationStructureNV structure : structures) {
+    uint64_t handle = 0;
+    REQUIRE(nv.Handle(vk, structure, sizeof(handle), &handle) == VK_SUCCESS);
+    CHECK(handle != 0);
+    for (const uint64_t other : handles) CHECK(handle != other);
+    handles.push_back(handle);
+  }
+
+  // The instance of the bottom level, and scratch for the larger build.
+  auto instances = device.CreateBuffer(sizeof(VkAccelerationStructureInstanceNV), VK_BUFFER_USAGE_RAY_TRACING_BIT_NV);
+  VkAccelerationStructureInstanceNV instance_data{};
+  instance_data.transform.matrix[0][0] = instance_data.transform.matrix[1][1] = instance_data.transform.matrix[2][2] =
+      1;
+  instance_data.mask = 0xff;
+  instance_data.accelerationStructureReference = handles[0];
+  std::memcpy(instances.mapped, &instance_data, sizeof(instance_data));
+  auto scratch = device.CreateBuffer(704, VK_BUFFER_USAGE_RAY_TRACING_BIT_NV);
+  VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  pool_info.queryType = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV;
+  pool_info.queryCount = 1;
+  VkQueryPool query_pool = VK_NULL_HANDLE;
+  REQUIRE(vkCreateQueryPool(vk, &pool_info, nullptr, &query_pool) == VK_SUCCESS);
+
+  device.OneShot([&](VkCommandBuffer cb) {
+    vkCmdResetQueryPool(cb, query_pool, 0, 1);
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask =
+        VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_NV | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_NV;
+    barrier.dstAccessMask =
+        VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_NV | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_NV;
+    const auto wait_for_builds = [&] {
+      vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_NV,
+                           VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_NV, 0, 1, &barrier, 0, nullptr, 0,
+                           nullptr);
+    };
+    nv.CmdBuild(cb, &bottom_info, VK_NULL_HANDLE, 0, VK_FALSE, bottom, VK_NULL_HANDLE, scratch.buffer, 0);
+    wait_for_builds();
+    nv.CmdBuild(cb, &top_info, instances.buffer, 0, VK_FALSE, top, VK_NULL_HANDLE, scratch.buffer, 0);
+    wait_for_builds();
+    nv.CmdCopy(cb, clone, bottom, VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_NV);
+    nv.CmdWriteProperties(cb, 1, &bottom, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV, query_pool, 0);
+  });  // submitted and waited for
+  // Nothing was written (nv_ray_tracing.h): the query is as the reset left it, not ready, or 0 where the driver below
+  // answers acceleration-structure queries as available at any time (lavapipe).
+  uint64_t compacted_size = 77;
+  const VkResult read = vkGetQueryPoolResults(vk, query_pool, 0, 1, sizeof(compacted_size), &compacted_size,
+                                              sizeof(compacted_size), VK_QUERY_RESULT_64_BIT);
+  CHECK((read == VK_NOT_READY || (read == VK_SUCCESS && compacted_size == 0)));
+
+  vkDestroyQueryPool(vk, query_pool, nullptr);
+  for (const VkAccelerationStructureNV structure : structures) nv.Destroy(vk, structure, nullptr);
+  vkFreeMemory(vk, memory, nullptr);
+  device.Destroy(scratch);
+  device.Destroy(instances);
+  device.Destroy(geometry_data);
 }
 
 }  // namespace
