@@ -41,6 +41,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->AllocateDescriptorSets = reinterpret_cast<PFN_vkAllocateDescriptorSets>(gdpa(device, "vkAllocateDescriptorSets"));
   table->AllocateMemory = reinterpret_cast<PFN_vkAllocateMemory>(gdpa(device, "vkAllocateMemory"));
   table->BeginCommandBuffer = reinterpret_cast<PFN_vkBeginCommandBuffer>(gdpa(device, "vkBeginCommandBuffer"));
+  table->BindAccelerationStructureMemoryNV = reinterpret_cast<PFN_vkBindAccelerationStructureMemoryNV>(gdpa(device, "vkBindAccelerationStructureMemoryNV"));
   table->BindBufferMemory = reinterpret_cast<PFN_vkBindBufferMemory>(gdpa(device, "vkBindBufferMemory"));
   static constexpr const char* kBindBufferMemory2Names[] = {"vkBindBufferMemory2", "vkBindBufferMemory2KHR"};
   table->BindBufferMemory2 = reinterpret_cast<PFN_vkBindBufferMemory2>(LoadFirst(gdpa, device, kBindBufferMemory2Names));
@@ -53,9 +54,11 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CmdBindDescriptorBuffersEXT = reinterpret_cast<PFN_vkCmdBindDescriptorBuffersEXT>(gdpa(device, "vkCmdBindDescriptorBuffersEXT"));
   table->CmdBindDescriptorSets = reinterpret_cast<PFN_vkCmdBindDescriptorSets>(gdpa(device, "vkCmdBindDescriptorSets"));
   table->CmdBindPipeline = reinterpret_cast<PFN_vkCmdBindPipeline>(gdpa(device, "vkCmdBindPipeline"));
+  table->CmdBuildAccelerationStructureNV = reinterpret_cast<PFN_vkCmdBuildAccelerationStructureNV>(gdpa(device, "vkCmdBuildAccelerationStructureNV"));
   table->CmdBuildAccelerationStructuresIndirectKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresIndirectKHR>(gdpa(device, "vkCmdBuildAccelerationStructuresIndirectKHR"));
   table->CmdBuildAccelerationStructuresKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(gdpa(device, "vkCmdBuildAccelerationStructuresKHR"));
   table->CmdCopyAccelerationStructureKHR = reinterpret_cast<PFN_vkCmdCopyAccelerationStructureKHR>(gdpa(device, "vkCmdCopyAccelerationStructureKHR"));
+  table->CmdCopyAccelerationStructureNV = reinterpret_cast<PFN_vkCmdCopyAccelerationStructureNV>(gdpa(device, "vkCmdCopyAccelerationStructureNV"));
   table->CmdCopyAccelerationStructureToMemoryKHR = reinterpret_cast<PFN_vkCmdCopyAccelerationStructureToMemoryKHR>(gdpa(device, "vkCmdCopyAccelerationStructureToMemoryKHR"));
   table->CmdCopyBuffer = reinterpret_cast<PFN_vkCmdCopyBuffer>(gdpa(device, "vkCmdCopyBuffer"));
   table->CmdCopyMemoryToAccelerationStructureKHR = reinterpret_cast<PFN_vkCmdCopyMemoryToAccelerationStructureKHR>(gdpa(device, "vkCmdCopyMemoryToAccelerationStructureKHR"));
@@ -97,10 +100,12 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   static constexpr const char* kCmdWaitEvents2Names[] = {"vkCmdWaitEvents2", "vkCmdWaitEvents2KHR"};
   table->CmdWaitEvents2 = reinterpret_cast<PFN_vkCmdWaitEvents2>(LoadFirst(gdpa, device, kCmdWaitEvents2Names));
   table->CmdWriteAccelerationStructuresPropertiesKHR = reinterpret_cast<PFN_vkCmdWriteAccelerationStructuresPropertiesKHR>(gdpa(device, "vkCmdWriteAccelerationStructuresPropertiesKHR"));
+  table->CmdWriteAccelerationStructuresPropertiesNV = reinterpret_cast<PFN_vkCmdWriteAccelerationStructuresPropertiesNV>(gdpa(device, "vkCmdWriteAccelerationStructuresPropertiesNV"));
   table->CopyAccelerationStructureKHR = reinterpret_cast<PFN_vkCopyAccelerationStructureKHR>(gdpa(device, "vkCopyAccelerationStructureKHR"));
   table->CopyAccelerationStructureToMemoryKHR = reinterpret_cast<PFN_vkCopyAccelerationStructureToMemoryKHR>(gdpa(device, "vkCopyAccelerationStructureToMemoryKHR"));
   table->CopyMemoryToAccelerationStructureKHR = reinterpret_cast<PFN_vkCopyMemoryToAccelerationStructureKHR>(gdpa(device, "vkCopyMemoryToAccelerationStructureKHR"));
   table->CreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(gdpa(device, "vkCreateAccelerationStructureKHR"));
+  table->CreateAccelerationStructureNV = reinterpret_cast<PFN_vkCreateAccelerationStructureNV>(gdpa(device, "vkCreateAccelerationStructureNV"));
   table->CreateBuffer = reinterpret_cast<PFN_vkCreateBuffer>(gdpa(device, "vkCreateBuffer"));
   table->CreateCommandPool = reinterpret_cast<PFN_vkCreateCommandPool>(gdpa(device, "vkCreateCommandPool"));
   table->CreateComputePipelines = reinterpret_cast<PFN_vkCreateComputePipelines>(gdpa(device, "vkCreateComputePipelines"));
@@ -117,6 +122,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->CreateShaderModule = reinterpret_cast<PFN_vkCreateShaderModule>(gdpa(device, "vkCreateShaderModule"));
   table->DeferredOperationJoinKHR = reinterpret_cast<PFN_vkDeferredOperationJoinKHR>(gdpa(device, "vkDeferredOperationJoinKHR"));
   table->DestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(gdpa(device, "vkDestroyAccelerationStructureKHR"));
+  table->DestroyAccelerationStructureNV = reinterpret_cast<PFN_vkDestroyAccelerationStructureNV>(gdpa(device, "vkDestroyAccelerationStructureNV"));
   table->DestroyBuffer = reinterpret_cast<PFN_vkDestroyBuffer>(gdpa(device, "vkDestroyBuffer"));
   table->DestroyCommandPool = reinterpret_cast<PFN_vkDestroyCommandPool>(gdpa(device, "vkDestroyCommandPool"));
   table->DestroyDeferredOperationKHR = reinterpret_cast<PFN_vkDestroyDeferredOperationKHR>(gdpa(device, "vkDestroyDeferredOperationKHR"));
@@ -139,6 +145,7 @@ void InitDeviceDispatchTable(VkDevice device, PFN_vkGetDeviceProcAddr gdpa, Devi
   table->FreeMemory = reinterpret_cast<PFN_vkFreeMemory>(gdpa(device, "vkFreeMemory"));
   table->GetAccelerationStructureBuildSizesKHR = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(gdpa(device, "vkGetAccelerationStructureBuildSizesKHR"));
   table->GetAccelerationStructureDeviceAddressKHR = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(gdpa(device, "vkGetAccelerationStructureDeviceAddressKHR"));
+  table->GetAccelerationStructureMemoryRequirementsNV = reinterpret_cast<PFN_vkGetAccelerationStructureMemoryRequirementsNV>(gdpa(device, "vkGetAccelerationStructureMemoryRequirementsNV"));
   static constexpr const char* kGetBufferDeviceAddressNames[] = {"vkGetBufferDeviceAddress", "vkGetBufferDeviceAddressEXT", "vkGetBufferDeviceAddressKHR"};
   table->GetBufferDeviceAddress = reinterpret_cast<PFN_vkGetBufferDeviceAddress>(LoadFirst(gdpa, device, kGetBufferDeviceAddressNames));
   table->GetBufferMemoryRequirements = reinterpret_cast<PFN_vkGetBufferMemoryRequirements>(gdpa(device, "vkGetBufferMemoryRequirements"));

@@ -29,6 +29,7 @@ struct DeviceDispatchTable {
   PFN_vkAllocateDescriptorSets AllocateDescriptorSets = nullptr;
   PFN_vkAllocateMemory AllocateMemory = nullptr;
   PFN_vkBeginCommandBuffer BeginCommandBuffer = nullptr;
+  PFN_vkBindAccelerationStructureMemoryNV BindAccelerationStructureMemoryNV = nullptr;
   PFN_vkBindBufferMemory BindBufferMemory = nullptr;
   PFN_vkBindBufferMemory2 BindBufferMemory2 = nullptr;
   PFN_vkBuildAccelerationStructuresKHR BuildAccelerationStructuresKHR = nullptr;
@@ -38,9 +39,11 @@ struct DeviceDispatchTable {
   PFN_vkCmdBindDescriptorBuffersEXT CmdBindDescriptorBuffersEXT = nullptr;
   PFN_vkCmdBindDescriptorSets CmdBindDescriptorSets = nullptr;
   PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
+  PFN_vkCmdBuildAccelerationStructureNV CmdBuildAccelerationStructureNV = nullptr;
   PFN_vkCmdBuildAccelerationStructuresIndirectKHR CmdBuildAccelerationStructuresIndirectKHR = nullptr;
   PFN_vkCmdBuildAccelerationStructuresKHR CmdBuildAccelerationStructuresKHR = nullptr;
   PFN_vkCmdCopyAccelerationStructureKHR CmdCopyAccelerationStructureKHR = nullptr;
+  PFN_vkCmdCopyAccelerationStructureNV CmdCopyAccelerationStructureNV = nullptr;
   PFN_vkCmdCopyAccelerationStructureToMemoryKHR CmdCopyAccelerationStructureToMemoryKHR = nullptr;
   PFN_vkCmdCopyBuffer CmdCopyBuffer = nullptr;
   PFN_vkCmdCopyMemoryToAccelerationStructureKHR CmdCopyMemoryToAccelerationStructureKHR = nullptr;
@@ -75,10 +78,12 @@ struct DeviceDispatchTable {
   PFN_vkCmdWaitEvents CmdWaitEvents = nullptr;
   PFN_vkCmdWaitEvents2 CmdWaitEvents2 = nullptr;
   PFN_vkCmdWriteAccelerationStructuresPropertiesKHR CmdWriteAccelerationStructuresPropertiesKHR = nullptr;
+  PFN_vkCmdWriteAccelerationStructuresPropertiesNV CmdWriteAccelerationStructuresPropertiesNV = nullptr;
   PFN_vkCopyAccelerationStructureKHR CopyAccelerationStructureKHR = nullptr;
   PFN_vkCopyAccelerationStructureToMemoryKHR CopyAccelerationStructureToMemoryKHR = nullptr;
   PFN_vkCopyMemoryToAccelerationStructureKHR CopyMemoryToAccelerationStructureKHR = nullptr;
   PFN_vkCreateAccelerationStructureKHR CreateAccelerationStructureKHR = nullptr;
+  PFN_vkCreateAccelerationStructureNV CreateAccelerationStructureNV = nullptr;
   PFN_vkCreateBuffer CreateBuffer = nullptr;
   PFN_vkCreateCommandPool CreateCommandPool = nullptr;
   PFN_vkCreateComputePipelines CreateComputePipelines = nullptr;
@@ -94,6 +99,7 @@ struct DeviceDispatchTable {
   PFN_vkCreateShaderModule CreateShaderModule = nullptr;
   PFN_vkDeferredOperationJoinKHR DeferredOperationJoinKHR = nullptr;
   PFN_vkDestroyAccelerationStructureKHR DestroyAccelerationStructureKHR = nullptr;
+  PFN_vkDestroyAccelerationStructureNV DestroyAccelerationStructureNV = nullptr;
   PFN_vkDestroyBuffer DestroyBuffer = nullptr;
   PFN_vkDestroyCommandPool DestroyCommandPool = nullptr;
   PFN_vkDestroyDeferredOperationKHR DestroyDeferredOperationKHR = nullptr;
@@ -115,6 +121,7 @@ struct DeviceDispatchTable {
   PFN_vkFreeMemory FreeMemory = nullptr;
   PFN_vkGetAccelerationStructureBuildSizesKHR GetAccelerationStructureBuildSizesKHR = nullptr;
   PFN_vkGetAccelerationStructureDeviceAddressKHR GetAccelerationStructureDeviceAddressKHR = nullptr;
+  PFN_vkGetAccelerationStructureMemoryRequirementsNV GetAccelerationStructureMemoryRequirementsNV = nullptr;
   PFN_vkGetBufferDeviceAddress GetBufferDeviceAddress = nullptr;
   PFN_vkGetBufferMemoryRequirements GetBufferMemoryRequirements = nullptr;
   PFN_vkGetDeferredOperationResultKHR GetDeferredOperationResultKHR = nullptr;

@@ -10,6 +10,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkAllocateDescriptorSets",
     "vkAllocateMemory",
     "vkBeginCommandBuffer",
+    "vkBindAccelerationStructureMemoryNV",
     "vkBindBufferMemory",
     "vkBindBufferMemory2",
     "vkBindBufferMemory2KHR",
@@ -22,9 +23,11 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdBindDescriptorBuffersEXT",
     "vkCmdBindDescriptorSets",
     "vkCmdBindPipeline",
+    "vkCmdBuildAccelerationStructureNV",
     "vkCmdBuildAccelerationStructuresIndirectKHR",
     "vkCmdBuildAccelerationStructuresKHR",
     "vkCmdCopyAccelerationStructureKHR",
+    "vkCmdCopyAccelerationStructureNV",
     "vkCmdCopyAccelerationStructureToMemoryKHR",
     "vkCmdCopyMemoryToAccelerationStructureKHR",
     "vkCmdDispatch",
@@ -67,10 +70,12 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCmdWaitEvents2",
     "vkCmdWaitEvents2KHR",
     "vkCmdWriteAccelerationStructuresPropertiesKHR",
+    "vkCmdWriteAccelerationStructuresPropertiesNV",
     "vkCopyAccelerationStructureKHR",
     "vkCopyAccelerationStructureToMemoryKHR",
     "vkCopyMemoryToAccelerationStructureKHR",
     "vkCreateAccelerationStructureKHR",
+    "vkCreateAccelerationStructureNV",
     "vkCreateBuffer",
     "vkCreateCommandPool",
     "vkCreateComputePipelines",
@@ -88,6 +93,7 @@ const char* const kInterceptNames[kInterceptNameCount] = {
     "vkCreateShaderModule",
     "vkDeferredOperationJoinKHR",
     "vkDestroyAccelerationStructureKHR",
+    "vkDestroyAccelerationStructureNV",
     "vkDestroyBuffer",
     "vkDestroyCommandPool",
     "vkDestroyDebugUtilsMessengerEXT",
@@ -147,6 +153,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkAllocateDescriptorSets
     true,  // vkAllocateMemory
     true,  // vkBeginCommandBuffer
+    true,  // vkBindAccelerationStructureMemoryNV
     true,  // vkBindBufferMemory
     true,  // vkBindBufferMemory2
     true,  // vkBindBufferMemory2KHR
@@ -159,9 +166,11 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdBindDescriptorBuffersEXT
     true,  // vkCmdBindDescriptorSets
     true,  // vkCmdBindPipeline
+    true,  // vkCmdBuildAccelerationStructureNV
     true,  // vkCmdBuildAccelerationStructuresIndirectKHR
     true,  // vkCmdBuildAccelerationStructuresKHR
     true,  // vkCmdCopyAccelerationStructureKHR
+    true,  // vkCmdCopyAccelerationStructureNV
     true,  // vkCmdCopyAccelerationStructureToMemoryKHR
     true,  // vkCmdCopyMemoryToAccelerationStructureKHR
     true,  // vkCmdDispatch
@@ -204,10 +213,12 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCmdWaitEvents2
     true,  // vkCmdWaitEvents2KHR
     true,  // vkCmdWriteAccelerationStructuresPropertiesKHR
+    true,  // vkCmdWriteAccelerationStructuresPropertiesNV
     true,  // vkCopyAccelerationStructureKHR
     true,  // vkCopyAccelerationStructureToMemoryKHR
     true,  // vkCopyMemoryToAccelerationStructureKHR
     true,  // vkCreateAccelerationStructureKHR
+    true,  // vkCreateAccelerationStructureNV
     true,  // vkCreateBuffer
     true,  // vkCreateCommandPool
     true,  // vkCreateComputePipelines
@@ -225,6 +236,7 @@ const bool kInterceptNameIsDeviceLevel[kInterceptNameCount] = {
     true,  // vkCreateShaderModule
     true,  // vkDeferredOperationJoinKHR
     true,  // vkDestroyAccelerationStructureKHR
+    true,  // vkDestroyAccelerationStructureNV
     true,  // vkDestroyBuffer
     true,  // vkDestroyCommandPool
     false,  // vkDestroyDebugUtilsMessengerEXT

@@ -7,7 +7,7 @@
 
 namespace asval::hooks {
 
-inline constexpr std::size_t kInterceptNameCount = 134;
+inline constexpr std::size_t kInterceptNameCount = 140;
 
 // Sorted by strcmp, no duplicates.
 extern const char* const kInterceptNames[kInterceptNameCount];

@@ -4,6 +4,7 @@
 
 #include "build_report.h"
 #include "layer_settings.h"
+#include "nv_structures.h"
 #include "recorded_objects.h"
 #include "traced_structures.h"
 #include "vk_enum_string.h"
@@ -35,20 +36,26 @@ struct OpReporter {
   std::string CommandVuid(const char* suffix) const {
     return std::string("VUID-") + OpCommandName(op.origin.command) + "-" + suffix;
   }
+  // VK_NV_ray_tracing's commands name VkAccelerationStructureNV handles (their history keys: nv_structures.h).
+  bool nv() const { return IsNvCommand(op.origin.command); }
+  const char* TypeName() const { return nv() ? "VkAccelerationStructureNV" : "VkAccelerationStructureKHR"; }
   // Host calls: the element's own location; at submission the submitted command buffer's.
   Location Where() const {
     if (site.describe_origin) return site.loc;
-    if (std::string_view(OpCommandArrayName(op.origin.command)) == "pInfo") return site.loc.Field("pInfo");
+    const std::string_view array = OpCommandArrayName(op.origin.command);
+    if (array.empty()) return site.loc;
+    if (array == "pInfo") return site.loc.Field("pInfo");
     return site.loc.Field(OpCommandArrayName(op.origin.command), op.origin.element);
   }
   std::string Prefix() const { return site.describe_origin ? DescribeOrigin(op.origin) + ": " : std::string(); }
 
   [[gnu::cold, gnu::noinline]] void Add(Severity severity, std::string vuid, VkAccelerationStructureKHR subject,
                                         std::string message) const {
+    const VkObjectType type =
+        nv() ? VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_NV : VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR;
     out.Add(severity, std::move(vuid), Where(),
-            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted),
-             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, subject),
-             Obj(VK_OBJECT_TYPE_ACCELERATION_STRUCTURE_KHR, op.dst == subject ? VK_NULL_HANDLE : op.dst)},
+            {Obj(VK_OBJECT_TYPE_COMMAND_BUFFER, site.submitted), Obj(type, subject),
+             Obj(type, op.dst == subject ? VK_NULL_HANDLE : op.dst)},
             Prefix() + message);
   }
 
@@ -64,7 +71,7 @@ struct OpReporter {
 const AsHistory* ReadableHistory(const OpReporter& r, VkAccelerationStructureKHR as, AsHistory* storage) {
   const AsHistory* h = r.store.Find(as);
   if (!h) {
-    if (!r.state.acceleration_structures.contains(as)) {
+    if (!r.state.acceleration_structures.contains(as) && !FindNvByKey(r.state, as)) {
       r.CountSkip();
       return nullptr;
     }
@@ -81,13 +88,13 @@ const AsHistory* ReadableHistory(const OpReporter& r, VkAccelerationStructureKHR
 [[gnu::cold, gnu::noinline]] void ReportClobbered(const OpReporter& r, VkAccelerationStructureKHR as,
                                                   const AsHistory& h, const char* use) {
   const Clobber& c = *h.clobbered;
-  const std::string writer = c.writer ? fmt::format("writing VkAccelerationStructureKHR {}", Hex(c.writer))
+  const char* writer_type = IsNvCommand(c.by.command) ? "VkAccelerationStructureNV" : "VkAccelerationStructureKHR";
+  const std::string writer = c.writer ? fmt::format("writing {} {}", writer_type, Hex(c.writer))
                                       : std::string("writing serialized data");
   r.Add(Severity::kWarning, kClobberedId, as,
-        fmt::format("{} VkAccelerationStructureKHR {} after its memory was overwritten: {} ({}) wrote memory that "
-                    "overlaps it after it was last built. Its contents are no longer what was built; rebuild it "
-                    "before using it.",
-                    use, Hex(as), DescribeOrigin(c.by), writer));
+        fmt::format("{} {} {} after its memory was overwritten: {} ({}) wrote memory that overlaps it after it was "
+                    "last built. Its contents are no longer what was built; rebuild it before using it.",
+                    use, r.TypeName(), Hex(as), DescribeOrigin(c.by), writer));
 }
 
 // ---- updates -------------------------------------------------------------------------------------------------
@@ -100,7 +107,8 @@ const AsHistory* ReadableHistory(const OpReporter& r, VkAccelerationStructureKHR
 }
 
 std::string LastBuilt(const OpReporter& r, const BuildSnapshot& s) {
-  return fmt::format("srcAccelerationStructure {} was last built by {}", Hex(r.op.src), DescribeOrigin(s.origin));
+  return fmt::format("{} {} was last built by {}", r.nv() ? "src" : "srcAccelerationStructure", Hex(r.op.src),
+                     DescribeOrigin(s.origin));
 }
 
 [[gnu::cold, gnu::noinline]] void CompareUpdate(const OpReporter& r, const BuildSnapshot& s) {
@@ -209,7 +217,30 @@ bool UpdateMatches(const OpReporter& r, const BuildSnapshot& s, uint32_t* unknow
   return true;
 }
 
+// vkCmdBuildAccelerationStructureNV-update-02490: src was built with ALLOW_UPDATE. (Unlike the KHR command, the NV
+// one asks nothing else of the source's last build: dst-02488 compares the build with dst's creation info.)
+void CheckNvUpdate(const OpReporter& r) {
+  AsHistory storage;
+  const AsHistory* h = ReadableHistory(r, r.op.src, &storage);
+  if (!h) return;
+  if (h->clobbered) ReportClobbered(r, r.op.src, *h, "updates from");
+  if (h->kind == HistoryKind::kNeverBuilt || !h->build) {
+    r.Add(Severity::kError, "VUID-vkCmdBuildAccelerationStructureNV-update-02490", r.op.src,
+          fmt::format("update is VK_TRUE, but src {} has not been built by any operation executed before it: it was "
+                      "never constructed with VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_NV.",
+                      Hex(r.op.src)));
+    return;
+  }
+  if (!(h->build->flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_NV)) {
+    r.Add(Severity::kError, "VUID-vkCmdBuildAccelerationStructureNV-update-02490", r.op.src,
+          fmt::format("update is VK_TRUE, but {} with flags {}, without "
+                      "VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_NV.",
+                      LastBuilt(r, *h->build), BuildFlagsText(h->build->flags)));
+  }
+}
+
 void CheckUpdate(const OpReporter& r) {
+  if (r.nv()) return CheckNvUpdate(r);
   AsHistory storage;
   const AsHistory* h = ReadableHistory(r, r.op.src, &storage);
   if (!h) return;
@@ -242,6 +273,7 @@ void CheckCopySource(const OpReporter& r) {
   if (h->kind == HistoryKind::kNeverBuilt) {
     r.Add(Severity::kError,
           to_memory ? "VUID-VkCopyAccelerationStructureToMemoryInfoKHR-src-04959"
+          : r.nv()  ? "VUID-vkCmdCopyAccelerationStructureNV-src-04963"
                     : "VUID-VkCopyAccelerationStructureInfoKHR-src-04963",
           r.op.src,
           fmt::format("src {} has not been constructed (built, copied or deserialized) by any operation executed "
@@ -251,7 +283,10 @@ void CheckCopySource(const OpReporter& r) {
   }
   if (!to_memory && r.op.copy_mode == VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR && h->build &&
       !(h->build->flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
-    r.Add(Severity::kError, "VUID-VkCopyAccelerationStructureInfoKHR-src-03411", r.op.src,
+    r.Add(Severity::kError,
+          r.nv() ? "VUID-vkCmdCopyAccelerationStructureNV-src-03411"
+                 : "VUID-VkCopyAccelerationStructureInfoKHR-src-03411",
+          r.op.src,
           fmt::format("mode is VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR, but src {} was last built by {} "
                       "with flags {}, without VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR.",
                       Hex(r.op.src), DescribeOrigin(h->build->origin), BuildFlagsText(h->build->flags)));
@@ -279,19 +314,22 @@ void CheckPropertySource(const OpReporter& r) {
   const AsHistory* h = ReadableHistory(r, r.op.dst, &storage);
   if (!h) return;
   if (h->kind == HistoryKind::kNeverBuilt) {
-    r.Add(Severity::kError, r.CommandVuid("pAccelerationStructures-04964"), r.op.dst,
-          fmt::format("VkAccelerationStructureKHR {} has not been built by any operation executed before this "
-                      "property query.",
+    r.Add(Severity::kError, r.CommandVuid(r.nv() ? "pAccelerationStructures-04958" : "pAccelerationStructures-04964"),
+          r.op.dst,
+          fmt::format("{} {} has not been built by any operation executed before this property query.", r.TypeName(),
                       Hex(r.op.dst)));
     return;
   }
-  if (r.op.query_type == VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR && h->build &&
+  const VkQueryType compacted = r.nv() ? VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV
+                                       : VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR;
+  if (r.op.query_type == compacted && h->build &&
       !(h->build->flags & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR)) {
-    r.Add(Severity::kError, r.CommandVuid("accelerationStructures-03431"), r.op.dst,
-          fmt::format("queryType is VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, but "
-                      "VkAccelerationStructureKHR {} was last built by {} with flags {}, without "
+    r.Add(Severity::kError,
+          r.CommandVuid(r.nv() ? "pAccelerationStructures-06215" : "accelerationStructures-03431"), r.op.dst,
+          fmt::format("queryType is {}, but {} {} was last built by {} with flags {}, without "
                       "VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR.",
-                      Hex(r.op.dst), DescribeOrigin(h->build->origin), BuildFlagsText(h->build->flags)));
+                      string_VkQueryType(r.op.query_type), r.TypeName(), Hex(r.op.dst),
+                      DescribeOrigin(h->build->origin), BuildFlagsText(h->build->flags)));
   }
 }
 

@@ -41,12 +41,14 @@ ReportSettings ToReportSettings(const LayerSettings& s) {
   return r;
 }
 
-void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, DeviceProperties* out) {
+void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, bool nv_ray_tracing,
+                           DeviceProperties* out) {
   const InstanceDispatchTable& d = instance.dispatch;
   if (d.GetPhysicalDeviceMemoryProperties) d.GetPhysicalDeviceMemoryProperties(gpu, &out->memory);
   out->acceleration_structure.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
   if (d.GetPhysicalDeviceProperties2) {
-    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &out->acceleration_structure, {}};
+    VkPhysicalDeviceProperties2 props2{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &out->acceleration_structure, {}};
     d.GetPhysicalDeviceProperties2(gpu, &props2);
     out->core = props2.properties;
   } else if (d.GetPhysicalDeviceProperties) {
@@ -63,6 +65,14 @@ void QueryDeviceProperties(const InstanceData& instance, VkPhysicalDevice gpu, D
     VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &maintenance4, {}};
     d.GetPhysicalDeviceProperties2(gpu, &props2);
     if (maintenance4.maxBufferSize != 0) out->max_buffer_size = maintenance4.maxBufferSize;
+  }
+  // VK_NV_ray_tracing's limits (maxGeometryCount: vkCmdBuildAccelerationStructureNV-geometryCount-02241), asked only
+  // where the app enabled it: a driver without it need not know the structure.
+  if (nv_ray_tracing && d.GetPhysicalDeviceProperties2) {
+    out->ray_tracing_nv.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PROPERTIES_NV;
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &out->ray_tracing_nv, {}};
+    d.GetPhysicalDeviceProperties2(gpu, &props2);
+    out->ray_tracing_nv.pNext = nullptr;
   }
 }
 
@@ -171,7 +181,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice physicalDevice, con
       (((settings.capture_warnings & kCaptureWarnDegenerateInstance) && settings.Reports(kSeverityInfo)) ||
        (settings.capture_warnings & kCaptureWarnFloatSpacing));
   data->state.features = ParseEnabledFeatures(*pCreateInfo);
-  QueryDeviceProperties(*instance, physicalDevice, &data->state.properties);
+  data->state.features.nv_ray_tracing = EnablesExtension(*pCreateInfo, VK_NV_RAY_TRACING_EXTENSION_NAME);
+  QueryDeviceProperties(*instance, physicalDevice, data->state.features.nv_ray_tracing, &data->state.properties);
   data->state.properties.queue_families = QueueFamilies(*pCreateInfo);
   data->state.build_sizes.Init(*pDevice, data->dispatch.GetAccelerationStructureBuildSizesKHR);
   data->state.format_features.Init(physicalDevice, instance->dispatch.GetPhysicalDeviceFormatProperties);

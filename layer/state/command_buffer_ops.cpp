@@ -21,6 +21,9 @@ const char* OpCommandName(OpCommand command) {
     case OpCommand::kHostCopyMemoryTo: return "vkCopyMemoryToAccelerationStructureKHR";
     case OpCommand::kCmdWriteProperties: return "vkCmdWriteAccelerationStructuresPropertiesKHR";
     case OpCommand::kHostWriteProperties: return "vkWriteAccelerationStructuresPropertiesKHR";
+    case OpCommand::kCmdBuildNV: return "vkCmdBuildAccelerationStructureNV";
+    case OpCommand::kCmdCopyNV: return "vkCmdCopyAccelerationStructureNV";
+    case OpCommand::kCmdWritePropertiesNV: return "vkCmdWriteAccelerationStructuresPropertiesNV";
     case OpCommand::kCmdTraceRays: return "vkCmdTraceRaysKHR";
     case OpCommand::kCmdTraceRaysIndirect: return "vkCmdTraceRaysIndirectKHR";
     case OpCommand::kCmdTraceRaysIndirect2: return "vkCmdTraceRaysIndirect2KHR";
@@ -50,7 +53,9 @@ const char* OpCommandArrayName(OpCommand command) {
     case OpCommand::kCmdBuildIndirect:
     case OpCommand::kHostBuild: return "pInfos";
     case OpCommand::kCmdWriteProperties:
-    case OpCommand::kHostWriteProperties: return "pAccelerationStructures";
+    case OpCommand::kHostWriteProperties:
+    case OpCommand::kCmdWritePropertiesNV: return "pAccelerationStructures";
+    case OpCommand::kCmdCopyNV: return "";
     default: return "pInfo";
   }
 }
@@ -76,7 +81,7 @@ std::string Handle(const void* handle) {
 
 bool IsArray(OpCommand command) {
   const std::string_view name = OpCommandArrayName(command);
-  return name != "pInfo";
+  return name != "pInfo" && !name.empty();
 }
 
 }  // namespace
@@ -230,6 +235,68 @@ void OpBatch::AppendTrace(const OpOrigin& origin, const TracedBinding* bindings,
   op.geometry_count = count;
   if (count != 0) std::memcpy(traced_.Extend(count), bindings, count * sizeof(TracedBinding));
   ops_.push_back(op);
+}
+
+namespace {
+
+// One geometry of an NV build as a KHR build's record: its primitives are its triangles (indices, else vertices, in
+// threes) or AABBs.
+GeometryRecord NvGeometryRecord(const VkGeometryNV& g) {
+  GeometryRecord r;
+  r.type = g.geometryType;
+  r.flags = g.flags;
+  r.vertex_format = VK_FORMAT_UNDEFINED;
+  r.index_type = VK_INDEX_TYPE_NONE_KHR;
+  r.max_vertex = 0;
+  r.has_transform = false;
+  r.primitive_count_known = true;
+  if (g.geometryType == VK_GEOMETRY_TYPE_TRIANGLES_NV) {
+    const VkGeometryTrianglesNV& t = g.geometry.triangles;
+    r.vertex_format = t.vertexFormat;
+    r.index_type = t.indexType;
+    r.max_vertex = t.vertexCount == 0 ? 0 : t.vertexCount - 1;
+    r.has_transform = t.transformData != VK_NULL_HANDLE;
+    r.primitive_count = (t.indexType == VK_INDEX_TYPE_NONE_NV ? t.vertexCount : t.indexCount) / 3;
+  } else {
+    r.primitive_count = g.geometry.aabbs.numAABBs;
+  }
+  return r;
+}
+
+}  // namespace
+
+void OpBatch::AppendNvBuild(const OpOrigin& origin, const VkAccelerationStructureInfoNV& info, bool update,
+                            VkAccelerationStructureKHR dst, VkAccelerationStructureKHR src,
+                            uint64_t max_geometry_count) {
+  const bool top = info.type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_NV;
+  const bool walkable = top || info.geometryCount == 0 ||
+                        (info.pGeometries && (max_geometry_count == 0 || info.geometryCount <= max_geometry_count));
+  const uint32_t count = top ? 1 : (walkable ? info.geometryCount : 0);
+  geometries_.reserve(geometries_.size() + count);  // before the operation: a failure leaves none half-appended
+  AsOp& op = ops_.emplace_back();
+  op.origin = origin;
+  op.mode = update ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  op.src = update ? src : VK_NULL_HANDLE;
+  op.dst = dst;
+  op.flags = info.flags;
+  op.type = info.type;
+  op.first_geometry = static_cast<uint32_t>(geometries_.size());
+  op.geometry_count = count;
+  op.geometries_unreadable = !walkable;
+  if (top) {
+    GeometryRecord instances;
+    instances.type = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+    instances.flags = 0;
+    instances.vertex_format = VK_FORMAT_UNDEFINED;
+    instances.index_type = VK_INDEX_TYPE_NONE_KHR;
+    instances.max_vertex = 0;
+    instances.primitive_count = info.instanceCount;
+    instances.has_transform = false;
+    instances.primitive_count_known = true;
+    geometries_.push_back(instances);
+    return;
+  }
+  for (uint32_t j = 0; j < count; ++j) geometries_.push_back(NvGeometryRecord(info.pGeometries[j]));
 }
 
 void OpBatch::Append(const AsOp& op) {

@@ -36,6 +36,10 @@ enum class OpCommand : uint8_t {
   kHostCopyMemoryTo,
   kCmdWriteProperties,
   kHostWriteProperties,
+  // VK_NV_ray_tracing (issue 30): one structure per command; their operations share the history by handle value.
+  kCmdBuildNV,
+  kCmdCopyNV,
+  kCmdWritePropertiesNV,
   // Trace and ray-query work (OpKind::kTrace): the commands whose bound pipeline reads structure descriptors.
   kCmdTraceRays,
   kCmdTraceRaysIndirect,
@@ -62,8 +66,14 @@ constexpr std::size_t kOpCommandCount = static_cast<std::size_t>(OpCommand::kCou
 
 // "vkCmdBuildAccelerationStructuresKHR", ...
 const char* OpCommandName(OpCommand command);
-// The array parameter an operation is an element of: "pInfos", "pAccelerationStructures", or "pInfo".
+// The array parameter an operation is an element of: "pInfos", "pAccelerationStructures"; "pInfo" for a command of one
+// info, "" for one whose operation is its parameters themselves (vkCmdCopyAccelerationStructureNV).
 const char* OpCommandArrayName(OpCommand command);
+// Whether the command is VK_NV_ray_tracing's: its structures are VkAccelerationStructureNV.
+inline bool IsNvCommand(OpCommand command) {
+  return command == OpCommand::kCmdBuildNV || command == OpCommand::kCmdCopyNV ||
+         command == OpCommand::kCmdWritePropertiesNV;
+}
 
 // Where an operation was recorded.
 struct OpOrigin {
@@ -73,7 +83,8 @@ struct OpOrigin {
   VkCommandBuffer command_buffer = VK_NULL_HANDLE;  // where recorded; null for host calls
   VkCommandBuffer executed_by = VK_NULL_HANDLE;     // the primary that ran it, when recorded in a secondary
   // DeviceState::LastObjectId() when recorded (0 for host calls): a structure created or a buffer bound later is
-  // not what the command named, one destroyed later leaves the command buffer invalid (layer/checks/recorded_objects.h).
+  // not what the command named, one destroyed later leaves the command buffer invalid
+  // (layer/checks/recorded_objects.h).
   uint64_t recorded_at = 0;
 };
 
@@ -331,6 +342,11 @@ class OpBatch {
                     bool touches = true);
   // A trace or dispatch reading `count` structure bindings (kTrace).
   void AppendTrace(const OpOrigin& origin, const TracedBinding* bindings, uint32_t count);
+  // vkCmdBuildAccelerationStructureNV: one build or update of dst (keys: NvHistoryKey), its geometries recorded as a
+  // KHR build's would be (a top level as one instance geometry of instanceCount). Beyond max_geometry_count (its
+  // limit; 0: unknown, no limit) the geometries are not walked: the build is invalid as a whole (geometryCount-02241).
+  void AppendNvBuild(const OpOrigin& origin, const VkAccelerationStructureInfoNV& info, bool update,
+                     VkAccelerationStructureKHR dst, VkAccelerationStructureKHR src, uint64_t max_geometry_count);
   // Any other operation (no geometries); device serialization and deserialization touch their bytes.
   void Append(const AsOp& op);
   // Appends every operation of another batch (a secondary command buffer), marking it as run by `primary`.

@@ -33,6 +33,7 @@ struct DeviceFeatures {
   bool buffer_device_address = false;
   bool ray_query = false;
   bool ray_tracing_pipeline = false;
+  bool nv_ray_tracing = false;  // the device extension VK_NV_ray_tracing is enabled
   // Not a feature, but read from the same create-info chain: VkDeviceGroupDeviceCreateInfo::physicalDeviceCount.
   uint32_t physical_device_count = 1;
 };
@@ -40,6 +41,8 @@ struct DeviceFeatures {
 struct DeviceProperties {
   VkPhysicalDeviceProperties core{};
   VkPhysicalDeviceAccelerationStructurePropertiesKHR acceleration_structure{};
+  // Asked only where VK_NV_ray_tracing is enabled (zero otherwise: maxGeometryCount 0 means unknown).
+  VkPhysicalDeviceRayTracingPropertiesNV ray_tracing_nv{};
   VkPhysicalDeviceMemoryProperties memory{};
   // VkPhysicalDeviceMaintenance4Properties::maxBufferSize where the instance and the device are 1.3; else 2^30, the
   // least any implementation allows.
@@ -77,6 +80,7 @@ class DeviceState {
   ConcurrentMap<VkDeviceMemory, std::shared_ptr<const MemoryState>> memories;
   ConcurrentMap<VkBuffer, std::shared_ptr<const BufferState>> buffers;
   ConcurrentMap<VkAccelerationStructureKHR, std::shared_ptr<const AccelerationStructureState>> acceleration_structures;
+  ConcurrentMap<VkAccelerationStructureNV, std::shared_ptr<const NvStructureState>> nv_structures;
   // Device addresses of buffers created with SHADER_DEVICE_ADDRESS usage, once bound.
   DeviceAddressMap buffer_addresses;
 

@@ -5,6 +5,7 @@
 #include <new>
 
 #include "failure_injection.h"
+#include "nv_structures.h"
 #include "structure_memory.h"
 
 namespace asval {
@@ -87,7 +88,8 @@ std::optional<Written> Fresh(const DeviceState& state, HistoryStore& store, VkAc
   w->record = store.RecordOf(as);
   if (w->record != HistoryStore::kNoRecord && store.HistoryAt(w->record).span.memory != VK_NULL_HANDLE) {
     w->history.span = store.HistoryAt(w->record).span;
-  } else if (w->record == HistoryStore::kNoRecord && !state.acceleration_structures.contains(as)) {
+  } else if (w->record == HistoryStore::kNoRecord && !state.acceleration_structures.contains(as) &&
+             !FindNvByKey(state, as)) {
     return std::nullopt;
   } else if (std::optional<MemorySpan> span = AccelerationStructureSpan(state, as)) {
     w->history.span = *span;
@@ -457,6 +459,10 @@ bool NamesReplacedStructure(const DeviceState& state, const AsOp& op) {
   }
   const auto replaced = [&](VkAccelerationStructureKHR as) {
     if (!as) return false;
+    if (IsNvCommand(op.origin.command)) {
+      const std::shared_ptr<const NvStructureState> nv = FindNvByKey(state, as);
+      return nv && nv->serial > recorded_at;
+    }
     const std::optional<std::shared_ptr<const AccelerationStructureState>> now = state.acceleration_structures.find(as);
     return now && *now && (*now)->serial > recorded_at;
   };
@@ -490,8 +496,10 @@ void ApplyOnReplaced(const DeviceState& state, HistoryStore& store, const AsOp& 
 }  // namespace
 
 std::optional<MemorySpan> AccelerationStructureSpan(const DeviceState& state, VkAccelerationStructureKHR as) {
-  const std::optional<StructureMemory> memory = MemoryOfStructure(state, as);
-  return memory ? memory->Span() : std::nullopt;
+  if (const std::optional<StructureMemory> memory = MemoryOfStructure(state, as)) return memory->Span();
+  // VK_NV_ray_tracing: memory bound to the structure itself.
+  if (const std::shared_ptr<const NvStructureState> nv = FindNvByKey(state, as)) return NvStructureSpan(*nv);
+  return std::nullopt;
 }
 
 void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Transaction* txn) {
@@ -504,6 +512,17 @@ void ApplyUnknownCommandBuffer(const DeviceState& state, HistoryStore& store, Tr
     fresh->history.unknown_reason = UnknownReason::kLostOperations;
     store.Set(as, std::move(fresh->history), txn);
     store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);  // once it is
+  }
+  if (state.features.nv_ray_tracing) {
+    for (const auto& [nv, record] : state.nv_structures.snapshot()) {
+      if (!record || record->shares_key) continue;
+      std::optional<Written> fresh = Fresh(state, store, NvHistoryKey(nv));
+      if (!fresh) continue;
+      fresh->history.kind = HistoryKind::kUnknown;
+      fresh->history.unknown_reason = UnknownReason::kLostOperations;
+      store.Set(NvHistoryKey(nv), std::move(fresh->history), txn);
+      store.structures_made_unknown.fetch_add(1, std::memory_order_relaxed);
+    }
   }
   // Any serialized bytes may have been overwritten.
   store.InvalidateAllBlobs(txn);

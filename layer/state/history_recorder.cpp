@@ -6,6 +6,7 @@
 
 #include "failure_injection.h"
 #include "history_apply.h"
+#include "nv_structures.h"
 
 namespace asval {
 
@@ -190,10 +191,10 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
 
 void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
                               const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
-                              uint32_t first_query) {
+                              uint32_t first_query, OpCommand command) {
   std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
   if (!recording || !structures) return;
-  const OpOrigin origin = DeviceOrigin(state, *recording, OpCommand::kCmdWriteProperties, cb);
+  const OpOrigin origin = DeviceOrigin(state, *recording, command, cb);
   Guarded(state, *recording, [&] {
     for (uint32_t i = 0; i < count; ++i) {
       AsOp op;
@@ -207,6 +208,53 @@ void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t c
       recording->recording.Append(op);
     }
   });
+}
+
+namespace {
+
+// Whether the layer can follow an NV structure's history: null, or a live NV structure whose handle value no live KHR
+// structure shares. Otherwise counted: the command is not recorded.
+bool NvTrackable(const DeviceState& state, VkAccelerationStructureNV handle) {
+  if (handle == VK_NULL_HANDLE) return true;
+  const std::optional<std::shared_ptr<const NvStructureState>> found = state.nv_structures.find(handle);
+  if (found && *found && !(*found)->shares_key) return true;
+  if (found && *found) state.checks_skipped_unknown_state.fetch_add(1, std::memory_order_relaxed);
+  return !found || !*found;  // a handle the layer does not know: its operation is applied as any other's (Fresh)
+}
+
+}  // namespace
+
+void RecordCmdBuildNV(DeviceState& state, VkCommandBuffer cb, const VkAccelerationStructureInfoNV& info, bool update,
+                      VkAccelerationStructureNV dst, VkAccelerationStructureNV src) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording || !NvTrackable(state, dst) || !NvTrackable(state, update ? src : VK_NULL_HANDLE)) return;
+  const OpOrigin origin = DeviceOrigin(state, *recording, OpCommand::kCmdBuildNV, cb);
+  Guarded(state, *recording, [&] {
+    recording->recording.AppendNvBuild(origin, info, update, NvHistoryKey(dst), NvHistoryKey(src),
+                                       state.properties.ray_tracing_nv.maxGeometryCount);
+  });
+}
+
+void RecordCmdCopyNV(DeviceState& state, VkCommandBuffer cb, VkAccelerationStructureNV dst,
+                     VkAccelerationStructureNV src, VkCopyAccelerationStructureModeKHR mode) {
+  std::shared_ptr<CommandBufferState> recording = Recording(state, cb);
+  if (!recording || !NvTrackable(state, dst) || !NvTrackable(state, src)) return;
+  AsOp op = CopyKindOp(OpKind::kCopy, NvHistoryKey(src), NvHistoryKey(dst), mode);
+  op.origin = DeviceOrigin(state, *recording, OpCommand::kCmdCopyNV, cb);
+  Guarded(state, *recording, [&] { recording->recording.Append(op); });
+}
+
+void RecordCmdWritePropertiesNV(DeviceState& state, VkCommandBuffer cb, uint32_t count,
+                                const VkAccelerationStructureNV* structures, VkQueryType type, VkQueryPool pool,
+                                uint32_t first_query) {
+  if (!structures) return;
+  for (uint32_t i = 0; i < count; ++i) {
+    if (!NvTrackable(state, structures[i])) return;
+  }
+  // The same layout as an array of KHR handles: NvHistoryKey is the handle's value.
+  static_assert(sizeof(VkAccelerationStructureNV) == sizeof(VkAccelerationStructureKHR), "keys are handle values");
+  RecordCmdWriteProperties(state, cb, count, reinterpret_cast<const VkAccelerationStructureKHR*>(structures), type,
+                           pool, first_query, OpCommand::kCmdWritePropertiesNV);
 }
 
 void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipeline pipeline) {

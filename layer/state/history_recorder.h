@@ -38,7 +38,16 @@ void RecordCmdCopyMemoryTo(DeviceState& state, VkCommandBuffer cb,
                            const VkCopyMemoryToAccelerationStructureInfoKHR& info, uint32_t captured = 0);
 void RecordCmdWriteProperties(DeviceState& state, VkCommandBuffer cb, uint32_t count,
                               const VkAccelerationStructureKHR* structures, VkQueryType type, VkQueryPool pool,
-                              uint32_t first_query);
+                              uint32_t first_query, OpCommand command = OpCommand::kCmdWriteProperties);
+// VK_NV_ray_tracing's commands (structures keyed by NvHistoryKey). A command naming a structure whose handle value a
+// live KHR structure also has is not recorded (nv_structures.h: shares_key), and counted as unknown state.
+void RecordCmdBuildNV(DeviceState& state, VkCommandBuffer cb, const VkAccelerationStructureInfoNV& info, bool update,
+                      VkAccelerationStructureNV dst, VkAccelerationStructureNV src);
+void RecordCmdCopyNV(DeviceState& state, VkCommandBuffer cb, VkAccelerationStructureNV dst,
+                     VkAccelerationStructureNV src, VkCopyAccelerationStructureModeKHR mode);
+void RecordCmdWritePropertiesNV(DeviceState& state, VkCommandBuffer cb, uint32_t count,
+                                const VkAccelerationStructureNV* structures, VkQueryType type, VkQueryPool pool,
+                                uint32_t first_query);
 // vkCmdBindPipeline with VK_PIPELINE_BIND_POINT_COMPUTE, where the capture reduces on the device: the pipeline the
 // layer binds again after its dispatch (CommandBufferState::compute_pipeline).
 void RecordBindComputePipeline(DeviceState& state, VkCommandBuffer cb, VkPipeline pipeline);

@@ -5,6 +5,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <vector>
 
 namespace asval {
 
@@ -74,6 +75,37 @@ struct AccelerationStructureState {
   // The buffer was bound to memory when the structure was created. A binding never goes away, so the
   // bound-memory rules (pInfos-03707/03708) need no buffer lookup for such a structure.
   bool buffer_was_bound = false;
+};
+
+// A VK_NV_ray_tracing structure: created with its build parameters (VkAccelerationStructureInfoNV), then bound to
+// memory by vkBindAccelerationStructureMemoryNV (it has no buffer). Its build history shares the KHR structures'
+// store, keyed by the handle's value (history_key below).
+struct NvStructureState {
+  VkAccelerationStructureNV handle = VK_NULL_HANDLE;
+  uint64_t serial = 0;  // DeviceState::NextObjectId() at creation
+  // What each geometry of the creation info holds room for (dst-02488: a build may not exceed it).
+  struct GeometryRoom {
+    VkGeometryTypeKHR type = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    uint32_t vertices = 0;  // triangles: vertexCount
+    uint32_t indices = 0;   // triangles: indexCount (0 without indices)
+    uint32_t aabbs = 0;     // aabbs: numAABBs
+  };
+  VkAccelerationStructureTypeNV type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_NV;
+  VkBuildAccelerationStructureFlagsNV flags = 0;
+  uint32_t instance_count = 0;
+  std::vector<GeometryRoom> geometries;
+  VkDeviceSize compacted_size = 0;
+  // vkGetAccelerationStructureMemoryRequirementsNV's sizes, asked by the layer at creation; 0 when unknown.
+  VkDeviceSize object_size = 0;
+  VkDeviceSize build_scratch_size = 0;
+  VkDeviceSize update_scratch_size = 0;
+  // Set by vkBindAccelerationStructureMemoryNV.
+  bool bound = false;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize memory_offset = 0;
+  // The handle's value also names a live VkAccelerationStructureKHR (handles of different types may share values):
+  // its operations are then kept out of the build history, and the rules that need it skipped and counted.
+  bool shares_key = false;
 };
 
 }  // namespace asval

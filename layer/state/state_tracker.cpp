@@ -3,6 +3,7 @@
 #include <new>
 
 #include "failure_injection.h"
+#include "nv_structures.h"
 #include "vk_dispatch_table.h"
 #include "vk_struct_chain.h"
 
@@ -282,6 +283,7 @@ void RecordCreateAccelerationStructure(DeviceState& state, const DeviceDispatchT
   const bool awaiting = record->address == AccelerationStructureState::Address::kAwaitingBind;
   if (awaiting) state.structures_awaiting_address.fetch_add(1, std::memory_order_relaxed);
   state.acceleration_structures.insert_or_assign(handle, std::move(record));
+  if (state.features.nv_ray_tracing) NoteKhrStructureKey(state, handle);
   if (!awaiting) return;
   // Bound by another thread since it was looked at, before this record was there to be found: asked now.
   std::optional<std::shared_ptr<const BufferState>> now = state.buffers.find(info.buffer);
