@@ -8,6 +8,10 @@
 # Call: run(command="bash scripts/device_integration.sh", carry=[".gl", ".devrun"]). Failures land in
 # $OUT/failures.txt. An argument narrows the run further (a Catch2 test spec, e.g. "[protect]"); the tests that pass
 # invalid calls down stay out whatever it says.
+# ASVAL_DEVICE_KHRONOS=1 stacks the Khronos layer below asval, as the local self-validation run does: .devrun/khronos/
+# then holds Debian's libVkLayer_khronos_validation.so, its manifest (library_path "./...") and the run's
+# vk_layer_settings.txt (build/tests/integration/khronos_settings/). ASVAL_TEST_NV_NATIVE=1 runs the VK_NV_ray_tracing
+# tests ("[nv]") on the GPU's own extension instead of the test driver's (tests/integration/nv_helpers.h).
 for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
 export LD_LIBRARY_PATH=$PWD/.devrun/lib
 if ! ls /usr/share/vulkan/icd.d/nvidia_icd.json >/dev/null 2>&1 && ! ls /etc/vulkan/icd.d/nvidia_icd.json >/dev/null 2>&1; then
@@ -15,6 +19,10 @@ if ! ls /usr/share/vulkan/icd.d/nvidia_icd.json >/dev/null 2>&1 && ! ls /etc/vul
 fi
 export VK_LAYER_PATH=$PWD/.devrun/layer VK_LOADER_LAYERS_DISABLE='~implicit~'
 export XDG_DATA_HOME=/tmp/xdg HOME=/tmp/xdg VK_LAYER_SETTINGS_PATH=/tmp/xdg/none; mkdir -p /tmp/xdg
+if [ "${ASVAL_DEVICE_KHRONOS:-}" = 1 ]; then
+  export VK_LAYER_PATH=$VK_LAYER_PATH:$PWD/.devrun/khronos VK_LAYER_SETTINGS_PATH=$PWD/.devrun/khronos/vk_layer_settings.txt
+  export ASVAL_TEST_LAYERS=VK_LAYER_ASVAL_as_validation:VK_LAYER_KHRONOS_validation
+fi
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 bin=.devrun/asval_integration_tests
 $bin --list-tests --verbosity quiet "${1:-}~[passes-invalid-down]" > /tmp/names.txt

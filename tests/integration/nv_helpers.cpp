@@ -1,5 +1,6 @@
 #include "nv_helpers.h"
 
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -27,6 +28,11 @@ uint32_t FirstMemoryType(uint32_t bits) {
 }
 
 }  // namespace
+
+NvDriver::NvDriver() {
+  const char* native = std::getenv("ASVAL_TEST_NV_NATIVE");
+  if (!native || std::string(native) != "1") test_driver_.emplace();
+}
 
 vkkit::DeviceOptions NvRayTracing() {
   vkkit::DeviceOptions options;
@@ -169,6 +175,15 @@ uint64_t NvStructure::Reference() const {
   vkkit::Check(procs_.Handle(device_.handle(), handle_, sizeof(reference), &reference),
                "vkGetAccelerationStructureHandleNV");
   return reference;
+}
+
+VkAccelerationStructureInstanceNV NvStructure::Instance(uint32_t i) const {
+  VkAccelerationStructureInstanceNV instance{};
+  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
+  instance.transform.matrix[0][3] = 4.0f * static_cast<float>(i);
+  instance.mask = 0xff;
+  instance.accelerationStructureReference = Reference();
+  return instance;
 }
 
 void CmdBuildNV(vkkit::Device& device, VkCommandBuffer cb, const NvStructure& dst, VkBuffer scratch, bool update,

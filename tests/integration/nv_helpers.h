@@ -4,11 +4,24 @@
 // memory of their own (or to another structure's) as vkGetAccelerationStructureMemoryRequirementsNV asks.
 #include <vulkan/vulkan.h>
 
+#include <optional>
 #include <vector>
 
+#include "on_test_driver.h"
 #include "vkkit.h"
 
 namespace asval_test {
+
+// Where the NV tests run: on the test driver, which implements VK_NV_ray_tracing over a driver without it, unless
+// ASVAL_TEST_NV_NATIVE=1 says the driver below has the extension itself (an NVIDIA GPU: scripts/device_integration.sh).
+// Declare one before the fixture, as OnTestDriver.
+class NvDriver {
+ public:
+  NvDriver();
+
+ private:
+  std::optional<OnTestDriver> test_driver_;
+};
 
 // The device options of a program that enables VK_NV_ray_tracing.
 vkkit::DeviceOptions NvRayTracing();
@@ -62,6 +75,9 @@ class NvStructure {
   VkDeviceSize Requirement(VkAccelerationStructureMemoryRequirementsTypeNV type) const;
   // The 8 bytes vkGetAccelerationStructureHandleNV writes (instances reference it).
   uint64_t Reference() const;
+  // An instance of this structure (VkAccelerationStructureInstanceNV): identity transform moved 4 units along X per
+  // index `i`, mask 0xff.
+  VkAccelerationStructureInstanceNV Instance(uint32_t i) const;
 
  private:
   void Create(Memory memory, const NvStructure* share);

@@ -5,7 +5,6 @@
 
 #include "history_helpers.h"
 #include "nv_helpers.h"
-#include "on_test_driver.h"
 
 namespace asval_test {
 namespace {
@@ -36,7 +35,7 @@ TEST_CASE(
     "nv history: updates from a structure built without ALLOW_UPDATE, or never built, are reported when "
     "submitted (update-02490)",
     "[integration][nv][history][test-driver][passes-invalid-down]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("history", {}, NvRayTracing());
   NvProgram p(f.device());
   NvStructure fixed(p.device, 0, {p.inputs.Triangles(1)});
@@ -60,7 +59,7 @@ TEST_CASE(
     "nv history: a copy from a never-built structure and a compaction of one built without ALLOW_COMPACTION are "
     "reported when submitted (src-04963, src-03411)",
     "[integration][nv][history][test-driver][passes-invalid-down]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("history", {}, NvRayTracing());
   NvProgram p(f.device());
   NvStructure never(p.device, kCompactable, {p.inputs.Triangles(1)});
@@ -82,7 +81,7 @@ TEST_CASE(
     "nv history: compacted-size queries of a never-built structure and of one built without ALLOW_COMPACTION "
     "are reported when submitted (pAccelerationStructures-04958, pAccelerationStructures-06215)",
     "[integration][nv][history][test-driver][passes-invalid-down]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("history", {}, NvRayTracing());
   NvProgram p(f.device());
   NvStructure never(p.device, kCompactable, {p.inputs.Triangles(1)});
@@ -105,7 +104,7 @@ TEST_CASE(
     "nv history valid twin: updates, copies and compacted-size queries recorded before the builds they depend "
     "on, but submitted after them, stay silent; so do clones of clones and updates of a clone",
     "[integration][nv][history][test-driver][valid]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("history", {}, NvRayTracing());
   NvProgram p(f.device());
   const VkBuildAccelerationStructureFlagsNV both = kUpdatable | kCompactable;

@@ -4,10 +4,10 @@
 // every command the rules concern, well formed, and stays silent.
 #include <algorithm>
 #include <catch2/catch_test_macros.hpp>
+#include <cstring>
 
 #include "history_helpers.h"
 #include "nv_helpers.h"
-#include "on_test_driver.h"
 
 namespace asval_test {
 namespace {
@@ -29,7 +29,7 @@ TEST_CASE(
     "nv: build arguments beyond the device's limit or dst's creation info are reported (geometryCount-02241, "
     "dst-02488)",
     "[integration][nv][structure][test-driver][passes-invalid-down]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("structure", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -67,7 +67,7 @@ TEST_CASE(
 
 TEST_CASE("nv: an update without src and a build into an unbound structure are reported (update-02489, dst-07787)",
           "[integration][nv][handles][test-driver]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("handles", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -88,7 +88,7 @@ TEST_CASE(
     "nv: scratch smaller than the memory requirement or without RAY_TRACING usage, and instance data without it, "
     "are reported (update-02491, update-02492, scratch-03522, instanceData-03523)",
     "[integration][nv][addresses][test-driver]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("addresses", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -117,7 +117,7 @@ TEST_CASE(
 
 TEST_CASE("nv: an update whose src and dst are different structures over the same memory is reported (update-03526)",
           "[integration][nv][aliasing][test-driver]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("aliasing", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -136,7 +136,7 @@ TEST_CASE(
     "nv: copies with a wrong mode, into an unbound structure or over src's memory are reported (mode-03410, "
     "dst-07792, dst-07791)",
     "[integration][nv][copies][test-driver]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("copies", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -160,7 +160,7 @@ TEST_CASE(
     "nv: property writes of another query type, into a pool of another type or of an unbound structure are "
     "reported (queryType-06216, queryPool-03755, accelerationStructure-03757)",
     "[integration][nv][copies][test-driver]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f("copies", {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -190,7 +190,7 @@ TEST_CASE(
     "nv valid twin: builds, updates in place and from another structure, a top level over instance data, clones, "
     "compactions and compacted-size queries of well-formed NV structures stay silent",
     "[integration][nv][structure][handles][addresses][aliasing][copies][history][test-driver][valid]") {
-  const OnTestDriver driver;
+  const NvDriver driver;
   HistoryFixture f(nullptr, {}, NvRayTracing());
   vkkit::Device& device = f.device();
   NvInputs inputs(device);
@@ -206,13 +206,13 @@ TEST_CASE(
   NvStructure tlas(device, kUpdatable, 2);
   // Scratch of exactly the largest build requirement; instance data with RAY_TRACING usage.
   VkDeviceSize need = 0;
-  for (const NvStructure* s : {&full, &blas, &tlas}) {
+  for (const NvStructure* s : {&full, &blas, &twin, &boxes, &tlas}) {
     need = std::max(need, s->Requirement(VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_BUILD_SCRATCH_NV));
   }
   vkkit::Buffer scratch = NvBuffer(device, need);
   vkkit::Buffer update_scratch =
       NvBuffer(device, blas.Requirement(VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_UPDATE_SCRATCH_NV));
-  vkkit::Buffer instances = NvBuffer(device, 2 * 64);
+  vkkit::Buffer instances = NvBuffer(device, 2 * sizeof(VkAccelerationStructureInstanceNV));
   QueryPool pool(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV, 1);
   const NvProcs nv(device.handle());
   // Fewer vertices and AABBs than the creation info holds room for.
@@ -222,6 +222,9 @@ TEST_CASE(
   fewer_boxes.pGeometries = &one_box;
   VkAccelerationStructureInfoNV smaller = blas.info();
   smaller.pGeometries = fewer;
+  // The top level's instances reference the bottom levels by their NV handles (accelerationStructureReference-03786).
+  const VkAccelerationStructureInstanceNV records[2] = {blas.Instance(0), twin.Instance(1)};
+  std::memcpy(instances.mapped, records, sizeof(records));
   CHECK(Run(device, [&](Commands& commands, VkCommandBuffer cb) {
           pool.Reset(cb);
           CmdBuildNV(device, cb, full, scratch.buffer);
