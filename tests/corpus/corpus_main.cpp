@@ -74,8 +74,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT seve
 }
 
 // ASVAL_CORPUS_DEVICE_FEATURES: the acceleration-structure features the case's device enables beyond the default,
-// "host-commands", "indirect-build" and / or "held-submissions" (run_corpus.py asks for them where the case runs on
-// asval's test driver, which has both: tests/driver).
+// "host-commands", "indirect-build", "held-submissions" and / or "nv-ray-tracing" (the device extension
+// VK_NV_ray_tracing); run_corpus.py asks for them where the case runs on asval's test driver, which has them all:
+// tests/driver.
 vkkit::DeviceOptions OptionsFromEnvironment() {
   vkkit::DeviceOptions options;
   const char* env = std::getenv("ASVAL_CORPUS_DEVICE_FEATURES");
@@ -84,6 +85,9 @@ vkkit::DeviceOptions OptionsFromEnvironment() {
   options.indirect_build = features.find("indirect-build") != std::string::npos;
   // The test driver's held submissions (tests/driver/submission_hold.h) wait on a timeline semaphore.
   options.timeline_semaphore = features.find("held-submissions") != std::string::npos;
+  if (features.find("nv-ray-tracing") != std::string::npos) {
+    options.extensions.push_back(VK_NV_RAY_TRACING_EXTENSION_NAME);
+  }
   return options;
 }
 
