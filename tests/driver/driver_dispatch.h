@@ -50,7 +50,7 @@ struct DeviceFunctions {
   X(CmdWriteAccelerationStructuresPropertiesKHR) X(DestroyDeferredOperationKHR)                          \
   X(ResetCommandBuffer) X(CmdExecuteCommands) X(CmdCopyBuffer) X(BindBufferMemory2)                  \
   X(GetBufferMemoryRequirements2) X(GetDeviceBufferMemoryRequirements) X(CreateSemaphore) X(DestroySemaphore) \
-  X(SignalSemaphore)
+  X(SignalSemaphore) X(CreateAccelerationStructureKHR)
 // clang-format on
 #define ASVAL_DRIVER_DECLARE(name) PFN_vk##name name = nullptr;
   ASVAL_DRIVER_DEVICE_FUNCTIONS(ASVAL_DRIVER_DECLARE)
@@ -71,6 +71,7 @@ struct DeviceData {
   std::unique_ptr<DeviceBuffers> buffers;
   std::unique_ptr<IndirectBuilds> indirect;
   std::unique_ptr<NvRayTracing> nv;  // VK_NV_ray_tracing's structures (nv_ray_tracing.h)
+  bool motion_blur = false;          // VK_NV_ray_tracing_motion_blur enabled (motion_blur.h)
   SubmissionHold hold;               // under queue_lock (submission_hold.h)
 };
 

@@ -3,16 +3,19 @@
 // commands it executes itself. Everything else goes down the chain unchanged.
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "deferred_operations.h"
 #include "device_buffers.h"
 #include "device_executor.h"
+#include "device_extensions.h"
 #include "driver_dispatch.h"
 #include "host_commands.h"
 #include "indirect_builds.h"
 #include "memory_types.h"
+#include "motion_blur.h"
 #include "nv_ray_tracing.h"
 
 #define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
@@ -29,18 +32,25 @@ void AddFeatures(void* chain) {
       as->accelerationStructureIndirectBuild = VK_TRUE;
     }
   }
+  ReportMotionBlurFeatures(chain);
 }
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
   InstanceData* instance = InstanceOf(gpu);
-  instance->GetPhysicalDeviceFeatures2(gpu, features);
+  {
+    const MotionBlurFeaturesOutOfChain motion_blur(features);
+    instance->GetPhysicalDeviceFeatures2(gpu, features);
+  }
   AddFeatures(features->pNext);
 }
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2KHR(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
   InstanceData* instance = InstanceOf(gpu);
-  (instance->GetPhysicalDeviceFeatures2KHR ? instance->GetPhysicalDeviceFeatures2KHR
-                                           : instance->GetPhysicalDeviceFeatures2)(gpu, features);
+  {
+    const MotionBlurFeaturesOutOfChain motion_blur(features);
+    (instance->GetPhysicalDeviceFeatures2KHR ? instance->GetPhysicalDeviceFeatures2KHR
+                                             : instance->GetPhysicalDeviceFeatures2)(gpu, features);
+  }
   AddFeatures(features->pNext);
 }
 
@@ -82,13 +92,13 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2(VkPhysicalDevice gpu, Vk
   ReportDeviceType(&properties->properties);
 }
 
-// The device's extensions with those the test driver adds (nv_ray_tracing.h). A layer's name goes down the chain: the
-// loader answers the application's from the manifests.
+// The device's extensions with those the test driver adds (device_extensions.h). A layer's name goes down the chain:
+// the loader answers the application's from the manifests.
 VKAPI_ATTR VkResult VKAPI_CALL EnumerateDeviceExtensionProperties(VkPhysicalDevice gpu, const char* layer,
                                                                   uint32_t* count, VkExtensionProperties* properties) {
   InstanceData* instance = InstanceOf(gpu);
   if (layer != nullptr) return instance->EnumerateDeviceExtensionProperties(gpu, layer, count, properties);
-  return EnumerateDeviceExtensionsWithNv(instance->EnumerateDeviceExtensionProperties, gpu, count, properties);
+  return EnumerateDeviceExtensionsWithAdded(instance->EnumerateDeviceExtensionProperties, gpu, count, properties);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL EnumeratePhysicalDevices(VkInstance handle, uint32_t* count, VkPhysicalDevice* gpus) {
@@ -181,11 +191,12 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   const PFN_vkGetDeviceProcAddr next_gdpa = link->u.pLayerInfo->pfnNextGetDeviceProcAddr;
   link->u.pLayerInfo = link->u.pLayerInfo->pNext;
   auto create = reinterpret_cast<PFN_vkCreateDevice>(next_gipa(instance->instance, "vkCreateDevice"));
-  const DeviceCreateWithoutNv without_nv(*info);
+  DeviceCreateWithoutAdded create_info(*info);
   VkResult result;
   {
-    const HiddenFeatures hidden(info->pNext);
-    result = create(gpu, without_nv.below(), allocator, out);
+    const MotionBlurFeaturesOutOfChain motion_blur(create_info.below());
+    const HiddenFeatures hidden(create_info.below()->pNext);
+    result = create(gpu, create_info.below(), allocator, out);
   }
   if (result != VK_SUCCESS) return result;
   DeviceData* device = AddDevice(*out);
@@ -203,7 +214,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   AddMemoryType(&above);
   const uint32_t every_type = above.memoryTypeCount >= 32 ? ~0u : (1u << above.memoryTypeCount) - 1;
   device->nv =
-      std::make_unique<NvRayTracing>(without_nv.nv_enabled(), without_nv.ray_tracing_pipeline_enabled(), every_type);
+      std::make_unique<NvRayTracing>(create_info.nv_enabled(), create_info.ray_tracing_pipeline_enabled(), every_type);
+  device->motion_blur = create_info.motion_blur_enabled();
   return VK_SUCCESS;
 }
 
@@ -266,7 +278,9 @@ VKAPI_ATTR VkResult VKAPI_CALL BeginCommandBuffer(VkCommandBuffer command_buffer
 VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
     VkCommandBuffer command_buffer, uint32_t count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
     const VkDeviceAddress* addresses, const uint32_t* strides, const uint32_t* const* max_counts) {
-  FindDevice(command_buffer)->indirect->Record(command_buffer, count, infos, addresses, strides, max_counts);
+  DeviceData* device = FindDevice(command_buffer);
+  const BuildInfosBelow below(device->motion_blur, count, infos);  // without motion (motion_blur.h)
+  device->indirect->Record(command_buffer, count, below.get(), addresses, strides, max_counts);
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice handle, const VkBufferCreateInfo* info,
@@ -350,9 +364,10 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
 VKAPI_ATTR void VKAPI_CALL GetAccelerationStructureBuildSizesKHR(
     VkDevice handle, VkAccelerationStructureBuildTypeKHR, const VkAccelerationStructureBuildGeometryInfoKHR* info,
     const uint32_t* counts, VkAccelerationStructureBuildSizesInfoKHR* sizes) {
-  // Host builds run on the device: the device's sizes are theirs.
+  // Host builds run on the device: the device's sizes are theirs. Motion builds are built without motion: sized so.
   DeviceData* device = FindDevice(handle);
-  device->vk.GetAccelerationStructureBuildSizesKHR(handle, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, info,
+  const BuildInfosBelow below(device->motion_blur, 1, info);
+  device->vk.GetAccelerationStructureBuildSizesKHR(handle, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, below.get(),
                                                    counts, sizes);
 }
 
@@ -368,7 +383,9 @@ BuildAccelerationStructuresKHR(VkDevice handle, VkDeferredOperationKHR operation
                                const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                                const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
   DeviceData* device = FindDevice(handle);
-  return RunOrDefer(device, operation, [=] { return BuildOnHost(*device, count, infos, ranges); });
+  // Without motion (motion_blur.h), and kept as long as a deferred build needs it.
+  const auto below = std::make_shared<const BuildInfosBelow>(device->motion_blur, count, infos);
+  return RunOrDefer(device, operation, [=] { return BuildOnHost(*device, count, below->get(), ranges); });
 }
 
 VKAPI_ATTR VkResult VKAPI_CALL CopyAccelerationStructureKHR(VkDevice handle, VkDeferredOperationKHR operation,
@@ -482,9 +499,13 @@ PFN_vkVoidFunction GetDeviceProcAddr(VkDevice handle, const char* name) {
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
   DeviceData* device = handle != VK_NULL_HANDLE ? FindDevice(handle) : nullptr;
   if (device == nullptr) return nullptr;
-  // VK_NV_ray_tracing's commands only where it is enabled: elsewhere the device is the driver below's.
+  // VK_NV_ray_tracing's and VK_NV_ray_tracing_motion_blur's commands only where they are enabled: elsewhere the
+  // device is the driver below's.
   if (device->nv->enabled()) {
     if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;
+  }
+  if (device->motion_blur) {
+    if (PFN_vkVoidFunction motion_blur = MotionBlurFunction(name)) return motion_blur;
   }
   return device->next_gdpa(handle, name);
 }
@@ -498,6 +519,7 @@ PFN_vkVoidFunction GetInstanceProcAddr(VkInstance handle, const char* name) {
   if (handle == VK_NULL_HANDLE) return nullptr;
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
   if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;  // for any device: none is named here
+  if (PFN_vkVoidFunction motion_blur = MotionBlurFunction(name)) return motion_blur;  // they check their device
   InstanceData* instance = FindInstance(handle);
   return instance != nullptr ? instance->next_gipa(handle, name) : nullptr;
 }

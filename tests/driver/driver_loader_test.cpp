@@ -583,3 +583,187 @@ TEST_CASE("test driver: VK_NV_ray_tracing structures are created, sized, bound a
 }
 
 }  // namespace
+
+namespace {
+
+TEST_CASE("test driver: lists VK_NV_ray_tracing_motion_blur and reports its features") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  uint32_t listed = 0;
+  for (const VkExtensionProperties& e : DeviceExtensions(gpu)) {
+    if (std::strcmp(e.extensionName, VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME) != 0) continue;
+    ++listed;
+    CHECK(e.specVersion == 1);
+    CHECK(e.specVersion == kAsvalTestDriverMotionBlurSpecVersion);
+  }
+  CHECK(listed == 1);
+
+  // The motion-blur features between two structures the driver below fills: the chain stays whole.
+  VkPhysicalDeviceRayQueryFeaturesKHR ray_query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV motion_blur{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV, &ray_query};
+  motion_blur.rayTracingMotionBlurPipelineTraceRaysIndirect = VK_TRUE;  // overwritten
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR as{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &motion_blur};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &as};
+  vkGetPhysicalDeviceFeatures2(gpu, &features);
+  CHECK(features.pNext == &as);
+  CHECK(as.pNext == &motion_blur);
+  CHECK(motion_blur.pNext == &ray_query);
+  CHECK(as.accelerationStructure == VK_TRUE);
+  CHECK(ray_query.rayQuery == VK_TRUE);
+  CHECK(motion_blur.rayTracingMotionBlur == VK_TRUE);
+  CHECK(motion_blur.rayTracingMotionBlurPipelineTraceRaysIndirect == VK_FALSE);
+  // Alone first in the chain.
+  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV alone{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV};
+  VkPhysicalDeviceFeatures2 only{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &alone};
+  vkGetPhysicalDeviceFeatures2(gpu, &only);
+  CHECK(only.pNext == &alone);
+  CHECK(alone.pNext == nullptr);
+  CHECK(alone.rayTracingMotionBlur == kAsvalTestDriverRayTracingMotionBlur);
+  CHECK(alone.rayTracingMotionBlurPipelineTraceRaysIndirect ==
+        kAsvalTestDriverRayTracingMotionBlurPipelineTraceRaysIndirect);
+}
+
+TEST_CASE("test driver: a motion bottom level is created, sized and built over lavapipe where motion blur is enabled") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  // VK_NV_ray_tracing_motion_blur requires VK_KHR_ray_tracing_pipeline; the features go below vkkit's own.
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR pipeline{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  pipeline.rayTracingPipeline = VK_TRUE;
+  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV motion_blur{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV, &pipeline};
+  motion_blur.rayTracingMotionBlur = VK_TRUE;
+  vkkit::DeviceOptions options;
+  options.extensions = {VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME, VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME};
+  options.features = &motion_blur;
+  options.host_commands = true;                  // to read the built structure's serialization size
+  vkkit::Device device(instance, gpu, options);  // throws if the device cannot be created
+  const VkDevice vk = device.handle();
+  CHECK(motion_blur.pNext == &pipeline);  // the application's chain, as it gave it
+  CHECK(motion_blur.rayTracingMotionBlur == VK_TRUE);
+
+  // One triangle at time 0 (vertexData) and moved along z at time 1 (the motion triangles' vertexData).
+  const float vertices[2][3 * 3] = {{0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 0, 1, 1, 0, 1, 0, 1, 1}};
+  auto vertex_buffer =
+      device.CreateBuffer(sizeof(vertices), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  std::memcpy(vertex_buffer.mapped, vertices, sizeof(vertices));
+  VkAccelerationStructureGeometryMotionTrianglesDataNV motion_triangles{
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_MOTION_TRIANGLES_DATA_NV};
+  motion_triangles.vertexData.deviceAddress = vertex_buffer.address + sizeof(vertices[0]);
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  auto& t = geometry.geometry.triangles;
+  t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  t.pNext = &motion_triangles;
+  t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  t.vertexData.deviceAddress = vertex_buffer.address;
+  t.vertexStride = 3 * sizeof(float);
+  t.maxVertex = 2;
+  t.indexType = VK_INDEX_TYPE_NONE_KHR;
+  const VkAccelerationStructureGeometryKHR* geometries[] = {&geometry};  // through ppGeometries
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.flags =
+      VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV | VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.ppGeometries = geometries;
+  const uint32_t primitives = 1;
+  VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+  device.GetAccelerationStructureBuildSizesKHR(vk, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info, &primitives,
+                                               &sizes);
+  REQUIRE(sizes.accelerationStructureSize != 0);
+  REQUIRE(sizes.buildScratchSize != 0);
+
+  auto storage =
+      device.CreateBuffer(sizes.accelerationStructureSize, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+  auto scratch = device.CreateBuffer(sizes.buildScratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  VkAccelerationStructureMotionInfoNV motion_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_MOTION_INFO_NV};
+  motion_info.maxInstances = 0;
+  VkAccelerationStructureCreateInfoKHR create{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR, &motion_info};
+  create.createFlags = VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV;
+  create.buffer = storage.buffer;
+  create.size = sizes.accelerationStructureSize;
+  create.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  VkAccelerationStructureKHR structure = VK_NULL_HANDLE;
+  REQUIRE(device.CreateAccelerationStructureKHR(vk, &create, nullptr, &structure) == VK_SUCCESS);
+  REQUIRE(structure != VK_NULL_HANDLE);
+
+  info.dstAccelerationStructure = structure;
+  info.scratchData.deviceAddress = scratch.address;
+  const VkAccelerationStructureBuildRangeInfoKHR range{primitives, 0, 0, 0};
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+  REQUIRE_NOTHROW(device.OneShot([&](VkCommandBuffer cb) {  // submitted and waited for: vkkit throws on an error
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
+  }));
+
+  // The driver below got copies: the application's structures are as it gave them.
+  CHECK(create.createFlags == VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV);
+  CHECK(create.pNext == &motion_info);
+  CHECK((info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0);
+  CHECK(info.ppGeometries == geometries);
+  CHECK(info.pGeometries == nullptr);
+  CHECK(t.pNext == &motion_triangles);
+  CHECK(motion_triangles.pNext == nullptr);
+  // The host build path takes motion out too: the same geometry at host addresses, built by
+  // vkBuildAccelerationStructuresKHR into a second motion structure, holds what the device build holds.
+  VkAccelerationStructureKHR host_structure = VK_NULL_HANDLE;
+  auto host_storage =
+      device.CreateBuffer(sizes.accelerationStructureSize, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+  create.buffer = host_storage.buffer;
+  REQUIRE(device.CreateAccelerationStructureKHR(vk, &create, nullptr, &host_structure) == VK_SUCCESS);
+  VkAccelerationStructureBuildSizesInfoKHR host_sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+  device.GetAccelerationStructureBuildSizesKHR(vk, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_HOST_KHR, &info, &primitives,
+                                               &host_sizes);
+  std::vector<unsigned char> host_scratch(host_sizes.buildScratchSize);
+  VkAccelerationStructureGeometryMotionTrianglesDataNV host_motion = motion_triangles;
+  host_motion.vertexData.hostAddress = vertices[1];
+  VkAccelerationStructureGeometryKHR host_geometry = geometry;
+  host_geometry.geometry.triangles.pNext = &host_motion;
+  host_geometry.geometry.triangles.vertexData.hostAddress = vertices[0];
+  VkAccelerationStructureBuildGeometryInfoKHR host_info = info;
+  host_info.ppGeometries = nullptr;
+  host_info.pGeometries = &host_geometry;
+  host_info.dstAccelerationStructure = host_structure;
+  host_info.scratchData.hostAddress = host_scratch.data();
+  const auto host_build = reinterpret_cast<PFN_vkBuildAccelerationStructuresKHR>(
+      vkGetDeviceProcAddr(vk, "vkBuildAccelerationStructuresKHR"));
+  REQUIRE(host_build != nullptr);
+  REQUIRE(host_build(vk, VK_NULL_HANDLE, 1, &host_info, &ranges) == VK_SUCCESS);
+
+  const auto properties = reinterpret_cast<PFN_vkWriteAccelerationStructuresPropertiesKHR>(
+      vkGetDeviceProcAddr(vk, "vkWriteAccelerationStructuresPropertiesKHR"));
+  const auto to_memory = reinterpret_cast<PFN_vkCopyAccelerationStructureToMemoryKHR>(
+      vkGetDeviceProcAddr(vk, "vkCopyAccelerationStructureToMemoryKHR"));
+  REQUIRE(properties != nullptr);
+  REQUIRE(to_memory != nullptr);
+  const auto serialize = [&](VkAccelerationStructureKHR as) {
+    uint64_t size = 0;
+    REQUIRE(properties(vk, 1, &as, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_SERIALIZATION_SIZE_KHR, sizeof(size), &size,
+                       sizeof(size)) == VK_SUCCESS);
+    std::vector<unsigned char> bytes(size);
+    VkCopyAccelerationStructureToMemoryInfoKHR copy{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_TO_MEMORY_INFO_KHR};
+    copy.src = as;
+    copy.dst.hostAddress = bytes.data();
+    copy.mode = VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR;
+    REQUIRE(to_memory(vk, VK_NULL_HANDLE, &copy) == VK_SUCCESS);
+    return bytes;
+  };
+  const auto device_bytes = serialize(structure);
+  CHECK(!device_bytes.empty());
+  CHECK(Payload(serialize(host_structure)) == Payload(device_bytes));
+  CHECK(host_geometry.geometry.triangles.pNext == &host_motion);
+
+  device.DestroyAccelerationStructureKHR(vk, host_structure, nullptr);
+  device.Destroy(host_storage);
+  device.DestroyAccelerationStructureKHR(vk, structure, nullptr);
+  device.Destroy(scratch);
+  device.Destroy(storage);
+  device.Destroy(vertex_buffer);
+}
+
+}  // namespace

@@ -15,46 +15,11 @@ static_assert(AsvalTestDriverNvMemorySize(VK_ACCELERATION_STRUCTURE_MEMORY_REQUI
 static_assert(AsvalTestDriverNvMemorySize(VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_OBJECT_NV, 3, 1000) ==
               1024);
 
-bool IsNvRayTracing(const char* name) { return std::strcmp(name, VK_NV_RAY_TRACING_EXTENSION_NAME) == 0; }
-
 // The values vkGetAccelerationStructureHandleNV gives: never reused, in this process, so that two structures (of any
 // devices, alive or not) never share one.
 std::atomic<uint64_t> g_next_handle{1};
 
 }  // namespace
-
-VkResult EnumerateDeviceExtensionsWithNv(PFN_vkEnumerateDeviceExtensionProperties below, VkPhysicalDevice gpu,
-                                         uint32_t* count, VkExtensionProperties* properties) {
-  std::vector<VkExtensionProperties> all;
-  VkResult result;
-  do {  // below's list may grow between the two calls
-    uint32_t below_count = 0;
-    result = below(gpu, nullptr, &below_count, nullptr);
-    if (result != VK_SUCCESS) return result;
-    all.resize(below_count);
-    result = below(gpu, nullptr, &below_count, all.data());
-    all.resize(below_count);
-  } while (result == VK_INCOMPLETE);
-  if (result != VK_SUCCESS) return result;
-  // Listed once, as the test driver's, should the driver below have it too.
-  all.erase(std::remove_if(all.begin(), all.end(),
-                           [](const VkExtensionProperties& e) { return IsNvRayTracing(e.extensionName); }),
-            all.end());
-  VkExtensionProperties nv{};
-  std::strncpy(nv.extensionName, VK_NV_RAY_TRACING_EXTENSION_NAME, VK_MAX_EXTENSION_NAME_SIZE - 1);
-  nv.specVersion = kAsvalTestDriverNvRayTracingSpecVersion;
-  all.push_back(nv);
-
-  const auto total = static_cast<uint32_t>(all.size());
-  if (properties == nullptr) {
-    *count = total;
-    return VK_SUCCESS;
-  }
-  const uint32_t written = std::min(*count, total);
-  std::copy(all.begin(), all.begin() + written, properties);
-  *count = written;
-  return written < total ? VK_INCOMPLETE : VK_SUCCESS;
-}
 
 RayTracingPropertiesNV::RayTracingPropertiesNV(VkPhysicalDeviceProperties2* properties) {
   for (auto* s = reinterpret_cast<VkBaseOutStructure*>(properties); s->pNext != nullptr; s = s->pNext) {
@@ -78,20 +43,6 @@ RayTracingPropertiesNV::~RayTracingPropertiesNV() {
   properties_->maxInstanceCount = kAsvalTestDriverNvMaxInstanceCount;
   properties_->maxTriangleCount = kAsvalTestDriverNvMaxTriangleCount;
   properties_->maxDescriptorSetAccelerationStructures = kAsvalTestDriverNvMaxDescriptorSetAccelerationStructures;
-}
-
-DeviceCreateWithoutNv::DeviceCreateWithoutNv(const VkDeviceCreateInfo& info) : info_(info) {
-  for (uint32_t i = 0; i < info.enabledExtensionCount; ++i) {
-    const char* name = info.ppEnabledExtensionNames[i];
-    if (IsNvRayTracing(name)) {
-      nv_enabled_ = true;
-      continue;
-    }
-    if (std::strcmp(name, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) == 0) ray_tracing_pipeline_enabled_ = true;
-    extensions_.push_back(name);
-  }
-  info_.enabledExtensionCount = static_cast<uint32_t>(extensions_.size());
-  info_.ppEnabledExtensionNames = extensions_.empty() ? nullptr : extensions_.data();
 }
 
 NvRayTracing::NvRayTracing(bool enabled, bool ray_tracing_pipeline_enabled, uint32_t memory_type_bits)

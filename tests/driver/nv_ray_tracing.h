@@ -3,7 +3,7 @@
 // acceleration-structure commands. The test driver lists the extension, reports its properties (test_driver_api.h),
 // takes it out of the extensions the driver below is asked to enable, and implements the structures itself: heap
 // objects whose handle is their address, sized by AsvalTestDriverNvMemorySize (test_driver_api.h), bound to memory
-// it only records.
+// it only records (the listing and the taking out: device_extensions.h).
 //
 // Nothing is executed, as nothing is traced: vkCmdBuildAccelerationStructureNV, vkCmdCopyAccelerationStructureNV and
 // vkCmdWriteAccelerationStructuresPropertiesNV record nothing below, so no structure ever has contents, and the write
@@ -26,11 +26,6 @@
 
 namespace asval_test_driver {
 
-// vkEnumerateDeviceExtensionProperties with pLayerName NULL: below's extensions and VK_NV_ray_tracing, in the count
-// and VK_INCOMPLETE protocol.
-VkResult EnumerateDeviceExtensionsWithNv(PFN_vkEnumerateDeviceExtensionProperties below, VkPhysicalDevice gpu,
-                                         uint32_t* count, VkExtensionProperties* properties);
-
 // A VkPhysicalDeviceRayTracingPropertiesNV in a vkGetPhysicalDeviceProperties2 chain: out of the chain while the driver
 // below fills the others (it does not know the structure), then put back, filled with the test driver's limits.
 class RayTracingPropertiesNV {
@@ -43,25 +38,6 @@ class RayTracingPropertiesNV {
  private:
   VkBaseOutStructure* before_ = nullptr;  // the structure whose pNext it was
   VkPhysicalDeviceRayTracingPropertiesNV* properties_ = nullptr;
-};
-
-// vkCreateDevice's create info for the driver below: the application's, without VK_NV_ray_tracing in its extensions (a
-// copy of the array: the application's stays as it gave it).
-class DeviceCreateWithoutNv {
- public:
-  explicit DeviceCreateWithoutNv(const VkDeviceCreateInfo& info);
-  DeviceCreateWithoutNv(const DeviceCreateWithoutNv&) = delete;
-  DeviceCreateWithoutNv& operator=(const DeviceCreateWithoutNv&) = delete;
-
-  const VkDeviceCreateInfo* below() const { return &info_; }
-  bool nv_enabled() const { return nv_enabled_; }
-  bool ray_tracing_pipeline_enabled() const { return ray_tracing_pipeline_enabled_; }
-
- private:
-  std::vector<const char*> extensions_;
-  VkDeviceCreateInfo info_{};
-  bool nv_enabled_ = false;
-  bool ray_tracing_pipeline_enabled_ = false;
 };
 
 // One device's NV acceleration structures.

@@ -66,3 +66,13 @@ constexpr VkDeviceSize AsvalTestDriverNvMemorySize(VkAccelerationStructureMemory
       return compacted_size != 0 ? aligned(compacted_size) : aligned(1024 + 128 * primitives);
   }
 }
+
+// VK_NV_ray_tracing_motion_blur, which the test driver reports over a driver without it (motion_blur.h), so that the
+// layers above validate KHR structures and builds that use motion. Motion is not built: for a device that enables the
+// extension, creates and builds reach the driver below without their motion flags and structures (a bottom level with
+// motion triangles is built from its first vertex set), and a top level of motion instances is not supported.
+inline constexpr uint32_t kAsvalTestDriverMotionBlurSpecVersion = 1;
+
+// VkPhysicalDeviceRayTracingMotionBlurFeaturesNV as reported (the features a device may enable).
+inline constexpr VkBool32 kAsvalTestDriverRayTracingMotionBlur = VK_TRUE;
+inline constexpr VkBool32 kAsvalTestDriverRayTracingMotionBlurPipelineTraceRaysIndirect = VK_FALSE;
