@@ -64,6 +64,33 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
   return ReportDestinationType(ctx, cmd, i, dst, vuid);
 }
 
+[[gnu::cold, gnu::noinline]] bool ReportMotionMismatch(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                                                      bool created_with_motion) {
+  const VkAccelerationStructureBuildGeometryInfoKHR& info = cmd.infos[i];
+  if (created_with_motion) {
+    return ReportBuild(ctx, cmd, i, "VUID-VkAccelerationStructureBuildGeometryInfoKHR-dstAccelerationStructure-04927",
+                       [&](std::string&) { return InfoLocation(cmd, i).Field("flags"); },
+                       "(0x{:x}) lacks VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV, but dstAccelerationStructure "
+                       "(0x{:x}) was created with VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV.",
+                       info.flags, reinterpret_cast<uint64_t>(info.dstAccelerationStructure));
+  }
+  return ReportBuild(
+      ctx, cmd, i, "VUID-VkAccelerationStructureBuildGeometryInfoKHR-flags-04928",
+      [&](std::string&) { return InfoLocation(cmd, i).Field("flags"); },
+      "(0x{:x}) has VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV, but dstAccelerationStructure (0x{:x}) "
+      "was created without VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV.",
+      info.flags, reinterpret_cast<uint64_t>(info.dstAccelerationStructure));
+}
+
+// dstAccelerationStructure-04927 / flags-04928: a motion build into a structure created for motion, and only there.
+bool ValidateMotion(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
+                    const AccelerationStructureState& dst) {
+  const bool created_with_motion = (dst.create_flags & VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV) != 0;
+  const bool built_with_motion = (cmd.infos[i].flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
+  if (created_with_motion == built_with_motion) return false;
+  return ReportMotionMismatch(ctx, cmd, i, created_with_motion);
+}
+
 // pInfos-03707 / 03708: the structure's buffer is bound. Unknown buffers and sparse buffers (bound through
 // vkQueueBindSparse, which the layer does not follow) are skipped and counted.
 [[gnu::noinline]] bool ValidateBoundByLookup(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
@@ -75,10 +102,11 @@ bool ValidateDestinationType(const CheckContext& ctx, const BuildCommand& cmd, u
     return false;
   }
   if (buffer->bound) return false;
-  return ReportBuild(ctx, cmd, i, vuid, [&](std::string&) { return InfoLocation(cmd, i).Field(field); },
-                     "(0x{:x}) was created on VkBuffer 0x{:x}, which is not bound to device memory (no "
-                     "vkBindBufferMemory or vkBindBufferMemory2 for it succeeded).",
-                     reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
+  return ReportBuild(
+      ctx, cmd, i, vuid, [&](std::string&) { return InfoLocation(cmd, i).Field(field); },
+      "(0x{:x}) was created on VkBuffer 0x{:x}, which is not bound to device memory (no "
+      "vkBindBufferMemory or vkBindBufferMemory2 for it succeeded).",
+      reinterpret_cast<uint64_t>(as.handle), reinterpret_cast<uint64_t>(as.buffer));
 }
 
 inline bool ValidateBound(const CheckContext& ctx, const BuildCommand& cmd, uint32_t i,
@@ -100,6 +128,7 @@ bool ValidateInfoHandles(const CheckContext& ctx, const BuildCommand& cmd, uint3
     skip |= ReportInvalidDestination(ctx, cmd, i);
   } else {
     skip |= ValidateDestinationType(ctx, cmd, i, *dst);
+    skip |= ValidateMotion(ctx, cmd, i, *dst);
     if (!cmd.is_host()) skip |= ValidateBound(ctx, cmd, i, *dst, "pInfos-03707", "dstAccelerationStructure");
   }
   if (info.srcAccelerationStructure != VK_NULL_HANDLE) {
@@ -227,7 +256,8 @@ bool ValidateDistinctHandlesMany(const CheckContext& ctx, const BuildCommand& cm
 namespace {
 
 // Whether ValidateInfoHandles certainly has nothing to report or count for pInfos[i]: a live destination of the
-// build's type (or GENERIC), bound before it was created (or a host build), and no source, or a live one that needs
+// build's type (or GENERIC), bound before it was created (or a host build), created for motion exactly when the build
+// is a motion build, and no source, or a live one that needs
 // no binding test or was bound before it was created. Only compares, so that a loop over clean infos needs no call
 // and no stack frame; any other info takes the rules, which report exactly as before.
 inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStructureBuildGeometryInfoKHR& info,
@@ -240,6 +270,11 @@ inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStruct
     return false;
   }
   if (!cmd.is_host() && !dst->buffer_was_bound) return false;
+  // Motion (04927 / 04928): the build's motion flag and the destination's motion creation flag agree.
+  if (((info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0) !=
+      ((dst->create_flags & VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV) != 0)) {
+    return false;
+  }
   if (info.srcAccelerationStructure == VK_NULL_HANDLE) return true;
   if (!r.src) return false;
   return cmd.is_host() || info.mode != VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR || r.src->buffer_was_bound;
@@ -247,8 +282,8 @@ inline bool InfoHandlesClean(const BuildCommand& cmd, const VkAccelerationStruct
 
 // The per-info rules from pInfos[first] on, the first info that is not certainly clean, then the rules between
 // infos (out of line).
-[[gnu::noinline]] bool ValidateInfosFrom(const CheckContext& ctx, const BuildCommand& cmd, const ResolvedBuild& resolved,
-                                         uint32_t first) {
+[[gnu::noinline]] bool ValidateInfosFrom(const CheckContext& ctx, const BuildCommand& cmd,
+                                         const ResolvedBuild& resolved, uint32_t first) {
   bool skip = false;
   for (uint32_t i = first; i < cmd.info_count; ++i) {
     const ResolvedInfo& r = resolved.info(i);

@@ -8,6 +8,9 @@
 //   pInfos-03403                     no info's source is another info's destination
 //   pInfos-03707 / 03708             device builds: the buffer behind the destination (and, for updates, the
 //                                    source) is bound to memory
+//   VkAccelerationStructureBuildGeometryInfoKHR-flags-04928 / dstAccelerationStructure-04927
+//                                    a motion build (BUILD_MOTION_BIT_NV) writes a structure created for motion
+//                                    (CREATE_MOTION_BIT_NV), and only such a build writes one
 // The duplicate rules sort the handles (O(n log n)) in a per-thread buffer that is reused, so a steady
 // stream of many-info calls allocates nothing.
 #include "build_command.h"
