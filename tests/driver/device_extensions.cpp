@@ -15,6 +15,7 @@ struct Added {
 constexpr Added kAdded[] = {
     {VK_NV_RAY_TRACING_EXTENSION_NAME, kAsvalTestDriverNvRayTracingSpecVersion},
     {VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME, kAsvalTestDriverMotionBlurSpecVersion},
+    {VK_EXT_OPACITY_MICROMAP_EXTENSION_NAME, kAsvalTestDriverOpacityMicromapSpecVersion},
 };
 
 bool IsAdded(const char* name) {
@@ -63,6 +64,7 @@ DeviceCreateWithoutAdded::DeviceCreateWithoutAdded(const VkDeviceCreateInfo& inf
     const char* name = info.ppEnabledExtensionNames[i];
     if (std::strcmp(name, VK_NV_RAY_TRACING_EXTENSION_NAME) == 0) nv_enabled_ = true;
     if (std::strcmp(name, VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME) == 0) motion_blur_enabled_ = true;
+    if (std::strcmp(name, VK_EXT_OPACITY_MICROMAP_EXTENSION_NAME) == 0) opacity_micromap_enabled_ = true;
     if (std::strcmp(name, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) == 0) ray_tracing_pipeline_enabled_ = true;
     if (!IsAdded(name)) extensions_.push_back(name);
   }

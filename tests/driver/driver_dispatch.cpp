@@ -7,6 +7,7 @@
 #include "device_executor.h"
 #include "indirect_builds.h"
 #include "nv_ray_tracing.h"
+#include "opacity_micromap.h"
 
 namespace asval_test_driver {
 namespace {

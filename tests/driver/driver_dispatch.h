@@ -16,6 +16,7 @@ class DeferredOperations;
 class DeviceBuffers;
 class IndirectBuilds;
 class NvRayTracing;
+class Micromaps;
 
 struct InstanceData {
   VkInstance instance = VK_NULL_HANDLE;
@@ -70,9 +71,11 @@ struct DeviceData {
   std::unique_ptr<DeferredOperations> deferred;
   std::unique_ptr<DeviceBuffers> buffers;
   std::unique_ptr<IndirectBuilds> indirect;
-  std::unique_ptr<NvRayTracing> nv;  // VK_NV_ray_tracing's structures (nv_ray_tracing.h)
-  bool motion_blur = false;          // VK_NV_ray_tracing_motion_blur enabled (motion_blur.h)
-  SubmissionHold hold;               // under queue_lock (submission_hold.h)
+  std::unique_ptr<NvRayTracing> nv;      // VK_NV_ray_tracing's structures (nv_ray_tracing.h)
+  std::unique_ptr<Micromaps> micromaps;  // the test driver's own, whichever extensions are enabled (opacity_micromap.h)
+  bool motion_blur = false;              // VK_NV_ray_tracing_motion_blur enabled (motion_blur.h)
+  bool opacity_micromap = false;         // VK_EXT_opacity_micromap enabled (opacity_micromap.h, build_infos_below.h)
+  SubmissionHold hold;                   // under queue_lock (submission_hold.h)
 };
 
 void* DispatchKey(const void* handle);

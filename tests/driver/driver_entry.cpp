@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "build_infos_below.h"
+#include "chain_edits.h"
 #include "deferred_operations.h"
 #include "device_buffers.h"
 #include "device_executor.h"
@@ -17,6 +19,7 @@
 #include "memory_types.h"
 #include "motion_blur.h"
 #include "nv_ray_tracing.h"
+#include "opacity_micromap.h"
 
 #define ASVAL_DRIVER_EXPORT extern "C" __attribute__((visibility("default")))
 
@@ -33,12 +36,23 @@ void AddFeatures(void* chain) {
     }
   }
   ReportMotionBlurFeatures(chain);
+  ReportOpacityMicromapFeatures(chain);
 }
+
+// The features structures of the extensions the test driver adds, out of a chain the driver below reads (it has not
+// got the extensions) while it does.
+struct AddedFeaturesOutOfChain {
+  explicit AddedFeaturesOutOfChain(void* head)
+      : motion_blur(head, VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV),
+        opacity_micromap(head, VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_FEATURES_EXT) {}
+  const StructureOutOfChain motion_blur;
+  const StructureOutOfChain opacity_micromap;  // put back first: the chain's links are restored in reverse order
+};
 
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
   InstanceData* instance = InstanceOf(gpu);
   {
-    const MotionBlurFeaturesOutOfChain motion_blur(features);
+    const AddedFeaturesOutOfChain added(features);
     instance->GetPhysicalDeviceFeatures2(gpu, features);
   }
   AddFeatures(features->pNext);
@@ -47,7 +61,7 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2(VkPhysicalDevice gpu, VkPh
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceFeatures2KHR(VkPhysicalDevice gpu, VkPhysicalDeviceFeatures2* features) {
   InstanceData* instance = InstanceOf(gpu);
   {
-    const MotionBlurFeaturesOutOfChain motion_blur(features);
+    const AddedFeaturesOutOfChain added(features);
     (instance->GetPhysicalDeviceFeatures2KHR ? instance->GetPhysicalDeviceFeatures2KHR
                                              : instance->GetPhysicalDeviceFeatures2)(gpu, features);
   }
@@ -87,6 +101,7 @@ VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties(VkPhysicalDevice gpu, VkP
 VKAPI_ATTR void VKAPI_CALL GetPhysicalDeviceProperties2(VkPhysicalDevice gpu, VkPhysicalDeviceProperties2* properties) {
   InstanceData* instance = InstanceOf(gpu);
   const RayTracingPropertiesNV nv(properties);
+  const OpacityMicromapProperties opacity_micromap(properties);
   (instance->GetPhysicalDeviceProperties2 ? instance->GetPhysicalDeviceProperties2
                                           : instance->GetPhysicalDeviceProperties2KHR)(gpu, properties);
   ReportDeviceType(&properties->properties);
@@ -194,7 +209,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   DeviceCreateWithoutAdded create_info(*info);
   VkResult result;
   {
-    const MotionBlurFeaturesOutOfChain motion_blur(create_info.below());
+    const AddedFeaturesOutOfChain added(create_info.below());
     const HiddenFeatures hidden(create_info.below()->pNext);
     result = create(gpu, create_info.below(), allocator, out);
   }
@@ -216,6 +231,8 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateDevice(VkPhysicalDevice gpu, const VkDevice
   device->nv =
       std::make_unique<NvRayTracing>(create_info.nv_enabled(), create_info.ray_tracing_pipeline_enabled(), every_type);
   device->motion_blur = create_info.motion_blur_enabled();
+  device->opacity_micromap = create_info.opacity_micromap_enabled();
+  device->micromaps = std::make_unique<Micromaps>();
   return VK_SUCCESS;
 }
 
@@ -279,7 +296,7 @@ VKAPI_ATTR void VKAPI_CALL CmdBuildAccelerationStructuresIndirectKHR(
     VkCommandBuffer command_buffer, uint32_t count, const VkAccelerationStructureBuildGeometryInfoKHR* infos,
     const VkDeviceAddress* addresses, const uint32_t* strides, const uint32_t* const* max_counts) {
   DeviceData* device = FindDevice(command_buffer);
-  const BuildInfosBelow below(device->motion_blur, count, infos);  // without motion (motion_blur.h)
+  const BuildInfosBelow below(*device, count, infos);  // without the added extensions' (build_infos_below.h)
   device->indirect->Record(command_buffer, count, below.get(), addresses, strides, max_counts);
 }
 
@@ -287,7 +304,7 @@ VKAPI_ATTR VkResult VKAPI_CALL CreateBuffer(VkDevice handle, const VkBufferCreat
                                             const VkAllocationCallbacks* allocator, VkBuffer* buffer) {
   DeviceData* device = FindDevice(handle);
   VkBufferCreateInfo below = *info;
-  below.usage = device->nv->UsageBelow(info->usage);
+  below.usage = MicromapUsageBelow(device->opacity_micromap, device->nv->UsageBelow(info->usage));
   const VkResult result = device->vk.CreateBuffer(handle, &below, allocator, buffer);
   if (result == VK_SUCCESS) device->buffers->Created(*buffer, *info);
   return result;
@@ -364,9 +381,10 @@ VKAPI_ATTR VkResult VKAPI_CALL QueueWaitIdle(VkQueue queue) {
 VKAPI_ATTR void VKAPI_CALL GetAccelerationStructureBuildSizesKHR(
     VkDevice handle, VkAccelerationStructureBuildTypeKHR, const VkAccelerationStructureBuildGeometryInfoKHR* info,
     const uint32_t* counts, VkAccelerationStructureBuildSizesInfoKHR* sizes) {
-  // Host builds run on the device: the device's sizes are theirs. Motion builds are built without motion: sized so.
+  // Host builds run on the device: the device's sizes are theirs. Builds are built without motion and micromaps
+  // (build_infos_below.h): sized so.
   DeviceData* device = FindDevice(handle);
-  const BuildInfosBelow below(device->motion_blur, 1, info);
+  const BuildInfosBelow below(*device, 1, info);
   device->vk.GetAccelerationStructureBuildSizesKHR(handle, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, below.get(),
                                                    counts, sizes);
 }
@@ -383,8 +401,8 @@ BuildAccelerationStructuresKHR(VkDevice handle, VkDeferredOperationKHR operation
                                const VkAccelerationStructureBuildGeometryInfoKHR* infos,
                                const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) {
   DeviceData* device = FindDevice(handle);
-  // Without motion (motion_blur.h), and kept as long as a deferred build needs it.
-  const auto below = std::make_shared<const BuildInfosBelow>(device->motion_blur, count, infos);
+  // Without the added extensions' (build_infos_below.h), and kept as long as a deferred build needs it.
+  const auto below = std::make_shared<const BuildInfosBelow>(*device, count, infos);
   return RunOrDefer(device, operation, [=] { return BuildOnHost(*device, count, below->get(), ranges); });
 }
 
@@ -499,13 +517,19 @@ PFN_vkVoidFunction GetDeviceProcAddr(VkDevice handle, const char* name) {
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
   DeviceData* device = handle != VK_NULL_HANDLE ? FindDevice(handle) : nullptr;
   if (device == nullptr) return nullptr;
-  // VK_NV_ray_tracing's and VK_NV_ray_tracing_motion_blur's commands only where they are enabled: elsewhere the
-  // device is the driver below's.
+  // VK_NV_ray_tracing's, VK_NV_ray_tracing_motion_blur's and VK_EXT_opacity_micromap's commands only where they are
+  // enabled: elsewhere the device is the driver below's.
   if (device->nv->enabled()) {
     if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;
   }
   if (device->motion_blur) {
     if (PFN_vkVoidFunction motion_blur = MotionBlurFunction(name)) return motion_blur;
+  }
+  if (device->opacity_micromap) {
+    if (PFN_vkVoidFunction micromap = OpacityMicromapFunction(name)) return micromap;
+  }
+  if (device->motion_blur || device->opacity_micromap) {
+    if (PFN_vkVoidFunction build = BuildInfosBelowFunction(name)) return build;
   }
   return device->next_gdpa(handle, name);
 }
@@ -520,6 +544,8 @@ PFN_vkVoidFunction GetInstanceProcAddr(VkInstance handle, const char* name) {
   if (PFN_vkVoidFunction own = DeviceFunction(name)) return own;
   if (PFN_vkVoidFunction nv = NvRayTracingFunction(name)) return nv;  // for any device: none is named here
   if (PFN_vkVoidFunction motion_blur = MotionBlurFunction(name)) return motion_blur;  // they check their device
+  if (PFN_vkVoidFunction build = BuildInfosBelowFunction(name)) return build;
+  if (PFN_vkVoidFunction micromap = OpacityMicromapFunction(name)) return micromap;  // a device's own objects
   InstanceData* instance = FindInstance(handle);
   return instance != nullptr ? instance->next_gipa(handle, name) : nullptr;
 }

@@ -767,3 +767,197 @@ TEST_CASE("test driver: a motion bottom level is created, sized and built over l
 }
 
 }  // namespace
+
+namespace {
+
+TEST_CASE("test driver: lists VK_EXT_opacity_micromap and reports its features and properties") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  uint32_t listed = 0;
+  for (const VkExtensionProperties& e : DeviceExtensions(gpu)) {
+    if (std::strcmp(e.extensionName, VK_EXT_OPACITY_MICROMAP_EXTENSION_NAME) != 0) continue;
+    ++listed;
+    CHECK(e.specVersion == 2);
+    CHECK(e.specVersion == kAsvalTestDriverOpacityMicromapSpecVersion);
+  }
+  CHECK(listed == 1);
+
+  // The micromap features between the motion-blur ones and one the driver below fills: the chain stays whole.
+  VkPhysicalDeviceRayQueryFeaturesKHR ray_query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceOpacityMicromapFeaturesEXT micromap{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_FEATURES_EXT,
+                                                      &ray_query};
+  micromap.micromapCaptureReplay = VK_TRUE;  // overwritten
+  micromap.micromapHostCommands = VK_TRUE;   // overwritten
+  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV motion_blur{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV, &micromap};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &motion_blur};
+  vkGetPhysicalDeviceFeatures2(gpu, &features);
+  CHECK(features.pNext == &motion_blur);
+  CHECK(motion_blur.pNext == &micromap);
+  CHECK(micromap.pNext == &ray_query);
+  CHECK(ray_query.rayQuery == VK_TRUE);
+  CHECK(motion_blur.rayTracingMotionBlur == VK_TRUE);
+  CHECK(micromap.micromap == VK_TRUE);
+  CHECK(micromap.micromapCaptureReplay == VK_FALSE);
+  CHECK(micromap.micromapHostCommands == VK_FALSE);
+  CHECK(micromap.micromap == kAsvalTestDriverMicromap);
+  CHECK(micromap.micromapCaptureReplay == kAsvalTestDriverMicromapCaptureReplay);
+  CHECK(micromap.micromapHostCommands == kAsvalTestDriverMicromapHostCommands);
+
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+  VkPhysicalDeviceOpacityMicromapPropertiesEXT limits{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_PROPERTIES_EXT,
+                                                      &as};
+  VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &limits};
+  vkGetPhysicalDeviceProperties2(gpu, &properties);
+  CHECK(properties.pNext == &limits);
+  CHECK(limits.pNext == &as);
+  CHECK(as.maxGeometryCount != 0);  // the driver below filled the structure after the micromap one
+  CHECK(limits.maxOpacity2StateSubdivisionLevel == 12);
+  CHECK(limits.maxOpacity4StateSubdivisionLevel == 12);
+  CHECK(limits.maxOpacity2StateSubdivisionLevel == kAsvalTestDriverMaxOpacity2StateSubdivisionLevel);
+  CHECK(limits.maxOpacity4StateSubdivisionLevel == kAsvalTestDriverMaxOpacity4StateSubdivisionLevel);
+}
+
+TEST_CASE("test driver: a bottom level with an opacity micromap structure is built over lavapipe where enabled") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  const VkPhysicalDevice gpu = instance.FindRayTracingGpu();
+  VkPhysicalDeviceOpacityMicromapFeaturesEXT micromap_features{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_FEATURES_EXT};
+  micromap_features.micromap = VK_TRUE;
+  vkkit::DeviceOptions options;
+  options.extensions = {VK_EXT_OPACITY_MICROMAP_EXTENSION_NAME};
+  options.features = &micromap_features;
+  vkkit::Device device(instance, gpu, options);  // throws if the device cannot be created
+  const VkDevice vk = device.handle();
+  CHECK(micromap_features.pNext == nullptr);  // the application's chain, as it gave it
+  CHECK(micromap_features.micromap == VK_TRUE);
+
+  // A micromap of the test driver's own, sized by the documented formula.
+  const auto create_micromap = Load<PFN_vkCreateMicromapEXT>(vk, "vkCreateMicromapEXT");
+  const auto destroy_micromap = Load<PFN_vkDestroyMicromapEXT>(vk, "vkDestroyMicromapEXT");
+  const auto micromap_sizes = Load<PFN_vkGetMicromapBuildSizesEXT>(vk, "vkGetMicromapBuildSizesEXT");
+  const auto build_micromaps = Load<PFN_vkCmdBuildMicromapsEXT>(vk, "vkCmdBuildMicromapsEXT");
+  REQUIRE(create_micromap != nullptr);
+  REQUIRE(destroy_micromap != nullptr);
+  REQUIRE(micromap_sizes != nullptr);
+  REQUIRE(build_micromaps != nullptr);
+  // One 2-state triangle at subdivision level 0: one bit of data.
+  const VkMicromapUsageEXT usage{1, 0, VK_OPACITY_MICROMAP_FORMAT_2_STATE_EXT};
+  VkMicromapBuildInfoEXT micromap_build{VK_STRUCTURE_TYPE_MICROMAP_BUILD_INFO_EXT};
+  micromap_build.type = VK_MICROMAP_TYPE_OPACITY_MICROMAP_EXT;
+  micromap_build.mode = VK_BUILD_MICROMAP_MODE_BUILD_EXT;
+  micromap_build.usageCountsCount = 1;
+  micromap_build.pUsageCounts = &usage;
+  VkMicromapBuildSizesInfoEXT micromap_size{VK_STRUCTURE_TYPE_MICROMAP_BUILD_SIZES_INFO_EXT};
+  micromap_sizes(vk, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &micromap_build, &micromap_size);
+  CHECK(micromap_size.micromapSize == 256 + 64 * 1);
+  CHECK(micromap_size.micromapSize == AsvalTestDriverMicromapSize(micromap_build));
+  CHECK(micromap_size.buildScratchSize == kAsvalTestDriverMicromapBuildScratchSize);
+  CHECK(micromap_size.discardable == VK_FALSE);
+  auto micromap_storage = device.CreateBuffer(micromap_size.micromapSize, VK_BUFFER_USAGE_MICROMAP_STORAGE_BIT_EXT);
+  VkMicromapCreateInfoEXT micromap_create{VK_STRUCTURE_TYPE_MICROMAP_CREATE_INFO_EXT};
+  micromap_create.buffer = micromap_storage.buffer;
+  micromap_create.size = micromap_size.micromapSize;
+  micromap_create.type = VK_MICROMAP_TYPE_OPACITY_MICROMAP_EXT;
+  VkMicromapEXT micromap = VK_NULL_HANDLE;
+  REQUIRE(create_micromap(vk, &micromap_create, nullptr, &micromap) == VK_SUCCESS);
+  CHECK(micromap != VK_NULL_HANDLE);
+  // Its build inputs (the build records nothing below: the micromap has no contents).
+  const VkMicromapTriangleEXT micromap_triangle{0, 0, VK_OPACITY_MICROMAP_FORMAT_2_STATE_EXT};
+  auto micromap_input = device.CreateBuffer(16, VK_BUFFER_USAGE_MICROMAP_BUILD_INPUT_READ_ONLY_BIT_EXT);
+  std::memset(micromap_input.mapped, 0xff, 16);  // the data at offset 0: the triangle opaque
+  std::memcpy(static_cast<unsigned char*>(micromap_input.mapped) + 8, &micromap_triangle, sizeof(micromap_triangle));
+  auto micromap_scratch = device.CreateBuffer(micromap_size.buildScratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  micromap_build.dstMicromap = micromap;
+  micromap_build.data.deviceAddress = micromap_input.address;
+  micromap_build.triangleArray.deviceAddress = micromap_input.address + 8;
+  micromap_build.triangleArrayStride = sizeof(VkMicromapTriangleEXT);
+  micromap_build.scratchData.deviceAddress = micromap_scratch.address;
+
+  // One triangle whose micromap index is a special index: the whole triangle fully opaque, no micromap needed.
+  const float vertices[3 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  auto vertex_buffer =
+      device.CreateBuffer(sizeof(vertices), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  std::memcpy(vertex_buffer.mapped, vertices, sizeof(vertices));
+  const auto opaque = static_cast<uint32_t>(VK_OPACITY_MICROMAP_SPECIAL_INDEX_FULLY_OPAQUE_EXT);
+  auto index_buffer =
+      device.CreateBuffer(sizeof(opaque), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  std::memcpy(index_buffer.mapped, &opaque, sizeof(opaque));
+  VkAccelerationStructureTrianglesOpacityMicromapEXT triangles_micromap{
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_TRIANGLES_OPACITY_MICROMAP_EXT};
+  triangles_micromap.indexType = VK_INDEX_TYPE_UINT32;
+  triangles_micromap.indexBuffer.deviceAddress = index_buffer.address;
+  triangles_micromap.indexStride = sizeof(uint32_t);
+  triangles_micromap.micromap = VK_NULL_HANDLE;
+  triangles_micromap.usageCountsCount = 0;
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  auto& t = geometry.geometry.triangles;
+  t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  t.pNext = &triangles_micromap;
+  t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  t.vertexData.deviceAddress = vertex_buffer.address;
+  t.vertexStride = 3 * sizeof(float);
+  t.maxVertex = 2;
+  t.indexType = VK_INDEX_TYPE_NONE_KHR;
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_UPDATE_EXT |
+               VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  const uint32_t primitives = 1;
+  VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+  device.GetAccelerationStructureBuildSizesKHR(vk, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info, &primitives,
+                                               &sizes);
+  REQUIRE(sizes.accelerationStructureSize != 0);
+  REQUIRE(sizes.buildScratchSize != 0);
+  auto storage =
+      device.CreateBuffer(sizes.accelerationStructureSize, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+  auto scratch = device.CreateBuffer(sizes.buildScratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  VkAccelerationStructureCreateInfoKHR create{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+  create.buffer = storage.buffer;
+  create.size = sizes.accelerationStructureSize;
+  create.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  VkAccelerationStructureKHR structure = VK_NULL_HANDLE;
+  REQUIRE(device.CreateAccelerationStructureKHR(vk, &create, nullptr, &structure) == VK_SUCCESS);
+
+  info.dstAccelerationStructure = structure;
+  info.scratchData.deviceAddress = scratch.address;
+  const VkAccelerationStructureBuildRangeInfoKHR range{primitives, 0, 0, 0};
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+  REQUIRE_NOTHROW(device.OneShot([&](VkCommandBuffer cb) {  // submitted and waited for: vkkit throws on an error
+    build_micromaps(cb, 1, &micromap_build);
+    device.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
+  }));
+
+  // The driver below got copies: the application's structures are as it gave them.
+  CHECK(info.flags == (VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_OPACITY_MICROMAP_UPDATE_EXT |
+                       VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR));
+  CHECK(info.pGeometries == &geometry);
+  CHECK(info.ppGeometries == nullptr);
+  CHECK(t.pNext == &triangles_micromap);
+  CHECK(triangles_micromap.pNext == nullptr);
+  CHECK(triangles_micromap.indexBuffer.deviceAddress == index_buffer.address);
+
+  destroy_micromap(vk, micromap, nullptr);
+  device.DestroyAccelerationStructureKHR(vk, structure, nullptr);
+  device.Destroy(scratch);
+  device.Destroy(storage);
+  device.Destroy(micromap_scratch);
+  device.Destroy(micromap_input);
+  device.Destroy(micromap_storage);
+  device.Destroy(index_buffer);
+  device.Destroy(vertex_buffer);
+}
+
+TEST_CASE("test driver: VK_EXT_opacity_micromap's commands only where the extension is enabled") {
+  vkkit::Instance instance(vkkit::InstanceOptions{{"VK_LAYER_ASVAL_test_driver"}, nullptr, false});
+  vkkit::Device device(instance, instance.FindRayTracingGpu(), vkkit::DeviceOptions{});
+  CHECK(vkGetDeviceProcAddr(device.handle(), "vkCreateMicromapEXT") == nullptr);
+  CHECK(vkGetDeviceProcAddr(device.handle(), "vkCmdBuildMicromapsEXT") == nullptr);
+}
+
+}  // namespace

@@ -76,3 +76,30 @@ inline constexpr uint32_t kAsvalTestDriverMotionBlurSpecVersion = 1;
 // VkPhysicalDeviceRayTracingMotionBlurFeaturesNV as reported (the features a device may enable).
 inline constexpr VkBool32 kAsvalTestDriverRayTracingMotionBlur = VK_TRUE;
 inline constexpr VkBool32 kAsvalTestDriverRayTracingMotionBlurPipelineTraceRaysIndirect = VK_FALSE;
+
+// VK_EXT_opacity_micromap, which the test driver reports over a driver without it (opacity_micromap.h), so that the
+// layers above validate KHR builds whose triangles carry VkAccelerationStructureTrianglesOpacityMicromapEXT. Micromaps
+// are not executed: builds reach the driver below without the structure and the opacity-micromap build flags, and the
+// driver's own micromap objects have no contents.
+inline constexpr uint32_t kAsvalTestDriverOpacityMicromapSpecVersion = 2;
+
+// VkPhysicalDeviceOpacityMicromapFeaturesEXT as reported (the features a device may enable).
+inline constexpr VkBool32 kAsvalTestDriverMicromap = VK_TRUE;
+inline constexpr VkBool32 kAsvalTestDriverMicromapCaptureReplay = VK_FALSE;
+inline constexpr VkBool32 kAsvalTestDriverMicromapHostCommands = VK_FALSE;
+
+// VkPhysicalDeviceOpacityMicromapPropertiesEXT as reported.
+inline constexpr uint32_t kAsvalTestDriverMaxOpacity2StateSubdivisionLevel = 12;
+inline constexpr uint32_t kAsvalTestDriverMaxOpacity4StateSubdivisionLevel = 12;
+
+// vkGetMicromapBuildSizesEXT: micromapSize 256 + 64 T, where T is the sum of the counts of the build info's usage
+// counts (pUsageCounts or ppUsageCounts), buildScratchSize kAsvalTestDriverMicromapBuildScratchSize, discardable
+// VK_FALSE.
+inline constexpr VkDeviceSize kAsvalTestDriverMicromapBuildScratchSize = 256;
+constexpr VkDeviceSize AsvalTestDriverMicromapSize(const VkMicromapBuildInfoEXT& info) {
+  VkDeviceSize triangles = 0;
+  for (uint32_t i = 0; i < info.usageCountsCount; ++i) {
+    triangles += info.pUsageCounts != nullptr ? info.pUsageCounts[i].count : info.ppUsageCounts[i]->count;
+  }
+  return 256 + 64 * triangles;
+}
