@@ -3,7 +3,8 @@
 // VkAccelerationStructureBuildGeometryInfoKHR type-03654, pGeometries-03788, type-03789..03795, flags-03796,
 // flags-07334; the geometry data rules of VkAccelerationStructureGeometryTrianglesDataKHR (vertexStride-03735,
 // vertexStride-03819, vertexFormat-03797, indexType-03798) and VkAccelerationStructureGeometryAabbsDataKHR
-// (stride-03545, stride-03820). The range rules (VkAccelerationStructureBuildRangeInfoKHR) are in build_ranges.h.
+// (stride-03545, stride-03820), and of the VkAccelerationStructureTrianglesOpacityMicromapEXT a triangles geometry
+// chains (pUsageCounts-07335, indexType-10719, 10722, 10723). The range rules (VkAccelerationStructureBuildRangeInfoKHR) are in build_ranges.h.
 // Only bits and values these headers name are judged: flag bits and geometry types of newer extensions are
 // left alone.
 #include <cstdint>
