@@ -74,9 +74,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Print(VkDebugUtilsMessageSeverityFlagBitsEXT seve
 }
 
 // ASVAL_CORPUS_DEVICE_FEATURES: the acceleration-structure features the case's device enables beyond the default,
-// "host-commands", "indirect-build", "held-submissions" and / or "nv-ray-tracing" (the device extension
-// VK_NV_ray_tracing); run_corpus.py asks for them where the case runs on asval's test driver, which has them all:
-// tests/driver.
+// "host-commands", "indirect-build", "held-submissions" and / or the device extensions "nv-ray-tracing",
+// "motion-blur" (VK_NV_ray_tracing_motion_blur) and "opacity-micromap" (VK_EXT_opacity_micromap); run_corpus.py asks
+// for them where the case runs on asval's test driver, which has them all: tests/driver.
 vkkit::DeviceOptions OptionsFromEnvironment() {
   vkkit::DeviceOptions options;
   const char* env = std::getenv("ASVAL_CORPUS_DEVICE_FEATURES");
@@ -87,6 +87,24 @@ vkkit::DeviceOptions OptionsFromEnvironment() {
   options.timeline_semaphore = features.find("held-submissions") != std::string::npos;
   if (features.find("nv-ray-tracing") != std::string::npos) {
     options.extensions.push_back(VK_NV_RAY_TRACING_EXTENSION_NAME);
+  }
+  // The features these extensions need, chained for the device's lifetime (one device per process).
+  static VkPhysicalDeviceRayTracingMotionBlurFeaturesNV motion{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV};
+  static VkPhysicalDeviceOpacityMicromapFeaturesEXT micromap{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_FEATURES_EXT};
+  if (features.find("motion-blur") != std::string::npos) {
+    options.extensions.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);  // which the extension requires
+    options.extensions.push_back(VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME);
+    motion.rayTracingMotionBlur = VK_TRUE;
+    motion.pNext = options.features;
+    options.features = &motion;
+  }
+  if (features.find("opacity-micromap") != std::string::npos) {
+    options.extensions.push_back(VK_EXT_OPACITY_MICROMAP_EXTENSION_NAME);
+    micromap.micromap = VK_TRUE;
+    micromap.pNext = options.features;
+    options.features = &micromap;
   }
   return options;
 }
