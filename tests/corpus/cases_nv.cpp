@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "corpus.h"
-#include "history_helpers.h"
 #include "nv_helpers.h"
 
 namespace {
@@ -18,20 +17,11 @@ using asval_test::NvInputs;
 using asval_test::NvProcs;
 using asval_test::NvStructure;
 using asval_test::QueryPool;
+using asval_test::RunCommands;
 
 constexpr const char* kNv = "nv-ray-tracing";
 constexpr VkBuildAccelerationStructureFlagsNV kUpdatable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_NV;
 constexpr VkBuildAccelerationStructureFlagsNV kCompactable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_NV;
-
-// Records `record` into one command buffer and submits it, waiting for the queue.
-template <typename Recorder>
-void Run(vkkit::Device& device, Recorder&& record) {
-  Commands commands(device);
-  VkCommandBuffer cb = commands.Begin();
-  record(commands, cb);
-  commands.End(cb);
-  commands.Submit(cb);
-}
 
 CORPUS_CASE_ON_TEST_DRIVER(NvUpdateWithoutAllowUpdate, "nv-update-of-structure-built-without-allow-update", "history",
                            kNv, "a bottom level built without ALLOW_UPDATE, refit the next frame",
@@ -39,8 +29,9 @@ CORPUS_CASE_ON_TEST_DRIVER(NvUpdateWithoutAllowUpdate, "nv-update-of-structure-b
   NvInputs inputs(device);
   NvStructure blas(device, 0, {inputs.Triangles(2)});
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer, true, &blas); });
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
+  RunCommands(device,
+              [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer, true, &blas); });
   device.Destroy(scratch);
 }
 
@@ -52,8 +43,8 @@ CORPUS_CASE_ON_TEST_DRIVER(NvCompactWithoutAllowCompaction, "nv-compaction-of-st
   NvStructure compact(device, 0, {inputs.Triangles(2)});
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
   const NvProcs nv(device.handle());
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
-  Run(device, [&](Commands&, VkCommandBuffer cb) {
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
     nv.CmdCopy(cb, compact.handle(), blas.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
   });
   device.Destroy(scratch);
@@ -66,7 +57,7 @@ CORPUS_CASE_ON_TEST_DRIVER(NvUpdateScratchTooSmall, "nv-build-scratch-smaller-th
   NvStructure blas(device, kUpdatable, {inputs.Triangles(2)});
   vkkit::Buffer scratch =
       NvBuffer(device, blas.Requirement(VK_ACCELERATION_STRUCTURE_MEMORY_REQUIREMENTS_TYPE_UPDATE_SCRATCH_NV));
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer); });
   device.Destroy(scratch);
 }
 
@@ -79,8 +70,9 @@ CORPUS_CASE_ON_TEST_DRIVER(NvBuildBeyondCreation, "nv-build-with-more-vertices-t
   const VkGeometryNV two = inputs.Triangles(2);
   VkAccelerationStructureInfoNV info = blas.info();
   info.pGeometries = &two;
-  Run(device,
-      [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, blas, scratch.buffer, false, nullptr, &info); });
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
+    CmdBuildNV(device, cb, blas, scratch.buffer, false, nullptr, &info);
+  });
   device.Destroy(scratch);
 }
 
@@ -91,8 +83,9 @@ CORPUS_CASE_ON_TEST_DRIVER(NvUpdateIntoAlias, "nv-update-into-structure-aliasing
   NvStructure src(device, kUpdatable, {inputs.Triangles(2)});
   NvStructure alias(device, kUpdatable, {inputs.Triangles(2)}, NvStructure::Memory::kOwn, &src);
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, src, scratch.buffer); });
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, alias, scratch.buffer, true, &src); });
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, src, scratch.buffer); });
+  RunCommands(device,
+              [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, alias, scratch.buffer, true, &src); });
   device.Destroy(scratch);
 }
 
@@ -104,7 +97,7 @@ CORPUS_CASE_ON_TEST_DRIVER(NvCopyIntoUnbound, "nv-clone-into-unbound-structure",
   NvStructure dst(device, 0, {inputs.Triangles(2)}, NvStructure::Memory::kUnbound);
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
   const NvProcs nv(device.handle());
-  Run(device, [&](Commands& commands, VkCommandBuffer cb) {
+  RunCommands(device, [&](Commands& commands, VkCommandBuffer cb) {
     CmdBuildNV(device, cb, src, scratch.buffer);
     commands.Barrier(cb);
     nv.CmdCopy(cb, dst.handle(), src.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
@@ -126,7 +119,7 @@ CORPUS_CASE_ON_TEST_DRIVER(NvFrames, "nv-frames-refit-bottom-and-top-levels", "p
   std::memcpy(instances.mapped, records, sizeof(records));
   for (int frame = 0; frame < 3; ++frame) {
     const bool update = frame > 0;
-    Run(device, [&](Commands& commands, VkCommandBuffer cb) {
+    RunCommands(device, [&](Commands& commands, VkCommandBuffer cb) {
       CmdBuildNV(device, cb, a, scratch.buffer, update, update ? &a : nullptr);
       commands.Barrier(cb);
       CmdBuildNV(device, cb, b, scratch.buffer, update, update ? &b : nullptr);
@@ -149,18 +142,19 @@ CORPUS_CASE_ON_TEST_DRIVER(NvCompactionFlow, "nv-compaction-flow-then-refit-of-t
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
   QueryPool pool(device, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV, 1);
   const NvProcs nv(device.handle());
-  Run(device, [&](Commands& commands, VkCommandBuffer cb) {
+  RunCommands(device, [&](Commands& commands, VkCommandBuffer cb) {
     pool.Reset(cb);
     CmdBuildNV(device, cb, *original, scratch.buffer);
     commands.Barrier(cb);
     const VkAccelerationStructureNV handle = original->handle();
     nv.CmdWriteProperties(cb, 1, &handle, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV, pool.handle(), 0);
   });
-  Run(device, [&](Commands&, VkCommandBuffer cb) {
+  RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
     nv.CmdCopy(cb, compact.handle(), original->handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
   });
   original.reset();
-  Run(device, [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, compact, scratch.buffer, true, &compact); });
+  RunCommands(device,
+              [&](Commands&, VkCommandBuffer cb) { CmdBuildNV(device, cb, compact, scratch.buffer, true, &compact); });
   device.Destroy(scratch);
 }
 

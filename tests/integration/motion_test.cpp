@@ -4,51 +4,12 @@
 // without it (tests/driver/motion_blur.h).
 #include <catch2/catch_test_macros.hpp>
 
+#include "build_extension_helpers.h"
 #include "on_test_driver.h"
 #include "record_checks_helpers.h"
 
 namespace asval_test {
 namespace {
-
-struct MotionDevice {
-  MotionDevice() {
-    // The extension requires VK_KHR_ray_tracing_pipeline (vkkit enables ray queries on lavapipe, which has them).
-    options.extensions.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
-    options.extensions.push_back(VK_NV_RAY_TRACING_MOTION_BLUR_EXTENSION_NAME);
-    features.rayTracingMotionBlur = VK_TRUE;
-    options.features = &features;
-  }
-  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV features{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV};
-  vkkit::DeviceOptions options;
-};
-
-// A bottom-level structure of 64 KiB created with or without CREATE_MOTION_BIT_NV; destroyed with the object.
-class MotionStructure {
- public:
-  MotionStructure(vkkit::Device& device, bool motion) : device_(device) {
-    storage_ = device.CreateBuffer(1 << 16, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
-    VkAccelerationStructureMotionInfoNV motion_info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_MOTION_INFO_NV};
-    VkAccelerationStructureCreateInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
-    info.pNext = motion ? &motion_info : nullptr;
-    info.createFlags = motion ? VK_ACCELERATION_STRUCTURE_CREATE_MOTION_BIT_NV : 0;
-    info.buffer = storage_.buffer;
-    info.size = storage_.size;
-    info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    vkkit::Check(device.CreateAccelerationStructureKHR(device.handle(), &info, nullptr, &handle_),
-                 "vkCreateAccelerationStructureKHR");
-  }
-  ~MotionStructure() {
-    device_.DestroyAccelerationStructureKHR(device_.handle(), handle_, nullptr);
-    device_.Destroy(storage_);
-  }
-  VkAccelerationStructureKHR handle() const { return handle_; }
-
- private:
-  vkkit::Device& device_;
-  vkkit::Buffer storage_;
-  VkAccelerationStructureKHR handle_ = VK_NULL_HANDLE;
-};
 
 // A one-triangle build into `dst`, with the motion flag and the second vertex set (the scene's vertices again) when
 // `motion`. `motion_data` must outlive the recording.
@@ -74,7 +35,7 @@ TEST_CASE(
     "motion flag into one created with it, are reported (flags-04928, dstAccelerationStructure-04927)",
     "[integration][handles][motion][test-driver][newer-input]") {
   const OnTestDriver driver;
-  MotionDevice motion_device;
+  const MotionBlurDevice motion_device;
   CheckFixture f("handles", motion_device.options);
   vkkit::Device& device = f.device();
   Scene scene(device);
@@ -101,7 +62,7 @@ TEST_CASE(
     "build into a plain structure, stay silent and execute",
     "[integration][handles][motion][test-driver][valid][newer-input]") {
   const OnTestDriver driver;
-  MotionDevice motion_device;
+  const MotionBlurDevice motion_device;
   CheckFixture f(nullptr, motion_device.options);
   vkkit::Device& device = f.device();
   Scene scene(device);

@@ -186,6 +186,18 @@ VkAccelerationStructureInstanceNV NvStructure::Instance(uint32_t i) const {
   return instance;
 }
 
+VkResult RunCommands(Commands& commands, const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBuffer cb = commands.Begin();
+  record(cb);
+  commands.End(cb);
+  return commands.Submit(cb);
+}
+
+VkResult RunCommands(vkkit::Device& device, const std::function<void(Commands&, VkCommandBuffer)>& record) {
+  Commands commands(device);
+  return RunCommands(commands, [&](VkCommandBuffer cb) { record(commands, cb); });
+}
+
 void CmdBuildNV(vkkit::Device& device, VkCommandBuffer cb, const NvStructure& dst, VkBuffer scratch, bool update,
                 const NvStructure* src, const VkAccelerationStructureInfoNV* info, VkBuffer instance_data) {
   const NvProcs procs(device.handle());

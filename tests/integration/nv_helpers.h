@@ -4,9 +4,11 @@
 // memory of their own (or to another structure's) as vkGetAccelerationStructureMemoryRequirementsNV asks.
 #include <vulkan/vulkan.h>
 
+#include <functional>
 #include <optional>
 #include <vector>
 
+#include "history_helpers.h"
 #include "on_test_driver.h"
 #include "vkkit.h"
 
@@ -94,6 +96,12 @@ class NvStructure {
 // A buffer created with `usage` (VK_BUFFER_USAGE_RAY_TRACING_BIT_NV for scratch and instances), of `size` bytes.
 vkkit::Buffer NvBuffer(vkkit::Device& device, VkDeviceSize size,
                        VkBufferUsageFlags usage = VK_BUFFER_USAGE_RAY_TRACING_BIT_NV);
+
+// Records `record` into a new command buffer of `commands` and submits it alone (waiting for the queue when the
+// layer let it through); the layer's result.
+VkResult RunCommands(Commands& commands, const std::function<void(VkCommandBuffer)>& record);
+// The same with a pool of its own.
+VkResult RunCommands(vkkit::Device& device, const std::function<void(Commands&, VkCommandBuffer)>& record);
 
 // vkCmdBuildAccelerationStructureNV of dst with dst's own creation info (or `info`), from src when updating.
 void CmdBuildNV(vkkit::Device& device, VkCommandBuffer cb, const NvStructure& dst, VkBuffer scratch,

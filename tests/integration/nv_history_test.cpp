@@ -3,7 +3,6 @@
 // (layer/state/nv_structures.h), through the loader on the test driver (tests/driver/nv_ray_tracing.h).
 #include <catch2/catch_test_macros.hpp>
 
-#include "history_helpers.h"
 #include "nv_helpers.h"
 
 namespace asval_test {
@@ -66,14 +65,14 @@ TEST_CASE(
   NvStructure plain(p.device, 0, {p.inputs.Triangles(1)});
   NvStructure dst(p.device, 0, {p.inputs.Triangles(1)});
   Commands commands(p.device);
-  REQUIRE(commands.Submit(Record(
-              commands, [&](VkCommandBuffer cb) { CmdBuildNV(p.device, cb, plain, p.scratch.buffer); })) == VK_SUCCESS);
+  REQUIRE(RunCommands(commands, [&](VkCommandBuffer cb) { CmdBuildNV(p.device, cb, plain, p.scratch.buffer); }) ==
+          VK_SUCCESS);
   f.monitor().Expect("VUID-vkCmdCopyAccelerationStructureNV-src-04963");
   f.monitor().Expect("VUID-vkCmdCopyAccelerationStructureNV-src-03411");
-  CHECK(commands.Submit(Record(commands, [&](VkCommandBuffer cb) {
-    p.nv.CmdCopy(cb, dst.handle(), never.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
-    p.nv.CmdCopy(cb, dst.handle(), plain.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
-  })) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(RunCommands(commands, [&](VkCommandBuffer cb) {
+          p.nv.CmdCopy(cb, dst.handle(), never.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
+          p.nv.CmdCopy(cb, dst.handle(), plain.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
+        }) == VK_ERROR_VALIDATION_FAILED_EXT);
   CHECK(f.monitor().Verify() == "");
 }
 
@@ -88,15 +87,15 @@ TEST_CASE(
   NvStructure plain(p.device, 0, {p.inputs.Triangles(1)});
   QueryPool pool(p.device, kCompactedSizeNV, 2);
   Commands commands(p.device);
-  REQUIRE(commands.Submit(Record(
-              commands, [&](VkCommandBuffer cb) { CmdBuildNV(p.device, cb, plain, p.scratch.buffer); })) == VK_SUCCESS);
+  REQUIRE(RunCommands(commands, [&](VkCommandBuffer cb) { CmdBuildNV(p.device, cb, plain, p.scratch.buffer); }) ==
+          VK_SUCCESS);
   f.monitor().Expect("VUID-vkCmdWriteAccelerationStructuresPropertiesNV-pAccelerationStructures-04958");
   f.monitor().Expect("VUID-vkCmdWriteAccelerationStructuresPropertiesNV-pAccelerationStructures-06215");
   const VkAccelerationStructureNV structures[2] = {never.handle(), plain.handle()};
-  CHECK(commands.Submit(Record(commands, [&](VkCommandBuffer cb) {
-    pool.Reset(cb);
-    p.nv.CmdWriteProperties(cb, 2, structures, kCompactedSizeNV, pool.handle(), 0);
-  })) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(RunCommands(commands, [&](VkCommandBuffer cb) {
+          pool.Reset(cb);
+          p.nv.CmdWriteProperties(cb, 2, structures, kCompactedSizeNV, pool.handle(), 0);
+        }) == VK_ERROR_VALIDATION_FAILED_EXT);
   CHECK(f.monitor().Verify() == "");
 }
 

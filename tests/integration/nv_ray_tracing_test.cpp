@@ -6,7 +6,6 @@
 #include <catch2/catch_test_macros.hpp>
 #include <cstring>
 
-#include "history_helpers.h"
 #include "nv_helpers.h"
 
 namespace asval_test {
@@ -14,16 +13,6 @@ namespace {
 
 constexpr VkBuildAccelerationStructureFlagsNV kUpdatable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_NV;
 constexpr VkBuildAccelerationStructureFlagsNV kCompactable = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_NV;
-
-// Records `record` into a new command buffer and submits it; the layer's result.
-template <typename Record>
-VkResult Run(vkkit::Device& device, Record&& record) {
-  Commands commands(device);
-  VkCommandBuffer cb = commands.Begin();
-  record(commands, cb);
-  commands.End(cb);
-  return commands.Submit(cb);
-}
 
 TEST_CASE(
     "nv: build arguments beyond the device's limit or dst's creation info are reported (geometryCount-02241, "
@@ -54,7 +43,7 @@ TEST_CASE(
   VkAccelerationStructureInfoNV boxes_info = boxes.info();
   boxes_info.pGeometries = &two_boxes;
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-dst-02488", 4);
-  CHECK(Run(device, [&](Commands&, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
           CmdBuildNV(device, cb, over, scratch.buffer);
           CmdBuildNV(device, cb, small, scratch.buffer, false, nullptr, &flags);
           CmdBuildNV(device, cb, small, scratch.buffer, false, nullptr, &counts);
@@ -76,7 +65,7 @@ TEST_CASE("nv: an update without src and a build into an unbound structure are r
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-update-02489");
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-dst-07787");
-  CHECK(Run(device, [&](Commands&, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
           CmdBuildNV(device, cb, bound, scratch.buffer, true, nullptr);
           CmdBuildNV(device, cb, unbound, scratch.buffer);
         }) == VK_SUCCESS);
@@ -105,7 +94,7 @@ TEST_CASE(
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-update-02492");
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-scratch-03522");
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-instanceData-03523");
-  CHECK(Run(device, [&](Commands&, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
           CmdBuildNV(device, cb, blas, short_build.buffer);
           CmdBuildNV(device, cb, blas, short_update.buffer, true, &blas);
           CmdBuildNV(device, cb, blas, storage_usage.buffer);
@@ -125,7 +114,7 @@ TEST_CASE("nv: an update whose src and dst are different structures over the sam
   NvStructure alias(device, kUpdatable, {inputs.Triangles(1)}, NvStructure::Memory::kOwn, &src);
   vkkit::Buffer scratch = NvBuffer(device, 1 << 20);
   f.monitor().Expect("VUID-vkCmdBuildAccelerationStructureNV-update-03526");
-  CHECK(Run(device, [&](Commands&, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
           CmdBuildNV(device, cb, alias, scratch.buffer, true, &src);
         }) == VK_SUCCESS);
   CHECK(f.monitor().Verify() == "");
@@ -148,7 +137,7 @@ TEST_CASE(
   f.monitor().Expect("VUID-vkCmdCopyAccelerationStructureNV-mode-03410");
   f.monitor().Expect("VUID-vkCmdCopyAccelerationStructureNV-dst-07792");
   f.monitor().Expect("VUID-vkCmdCopyAccelerationStructureNV-dst-07791");
-  CHECK(Run(device, [&](Commands&, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
           nv.CmdCopy(cb, dst.handle(), src.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_SERIALIZE_KHR);
           nv.CmdCopy(cb, unbound.handle(), src.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
           nv.CmdCopy(cb, alias.handle(), src.handle(), VK_COPY_ACCELERATION_STRUCTURE_MODE_CLONE_KHR);
@@ -174,7 +163,7 @@ TEST_CASE(
   f.monitor().Expect("VUID-vkCmdWriteAccelerationStructuresPropertiesNV-queryPool-03755");
   f.monitor().Expect("VUID-vkCmdWriteAccelerationStructuresPropertiesNV-accelerationStructure-03757");
   CHECK(
-      Run(device, [&](Commands&, VkCommandBuffer cb) {
+      RunCommands(device, [&](Commands&, VkCommandBuffer cb) {
         nv_pool.Reset(cb);
         khr_pool.Reset(cb);
         // The KHR query type, into a pool of that type: 06216 alone.
@@ -225,7 +214,7 @@ TEST_CASE(
   // The top level's instances reference the bottom levels by their NV handles (accelerationStructureReference-03786).
   const VkAccelerationStructureInstanceNV records[2] = {blas.Instance(0), twin.Instance(1)};
   std::memcpy(instances.mapped, records, sizeof(records));
-  CHECK(Run(device, [&](Commands& commands, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands& commands, VkCommandBuffer cb) {
           pool.Reset(cb);
           CmdBuildNV(device, cb, full, scratch.buffer);
           commands.Barrier(cb);
@@ -240,7 +229,7 @@ TEST_CASE(
           const VkAccelerationStructureNV b = blas.handle();
           nv.CmdWriteProperties(cb, 1, &b, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_NV, pool.handle(), 0);
         }) == VK_SUCCESS);
-  CHECK(Run(device, [&](Commands& commands, VkCommandBuffer cb) {
+  CHECK(RunCommands(device, [&](Commands& commands, VkCommandBuffer cb) {
           CmdBuildNV(device, cb, blas, update_scratch.buffer, true, &blas);  // in place
           commands.Barrier(cb);
           CmdBuildNV(device, cb, twin, update_scratch.buffer, true, &blas);  // from another structure, no aliasing

@@ -1,0 +1,70 @@
+#pragma once
+// Objects of the KHR builds' extensions that no local driver has (the test driver exposes them: tests/driver), for the
+// integration tests and the corpus: structures created for motion (VK_NV_ray_tracing_motion_blur) and opacity
+// micromaps (VK_EXT_opacity_micromap), and the device options that enable them.
+#include <vulkan/vulkan.h>
+
+#include "vkkit.h"
+
+namespace asval_test {
+
+// VK_NV_ray_tracing_motion_blur (and VK_KHR_ray_tracing_pipeline, which it requires) with rayTracingMotionBlur.
+struct MotionBlurDevice {
+  MotionBlurDevice();
+  MotionBlurDevice(const MotionBlurDevice&) = delete;
+  VkPhysicalDeviceRayTracingMotionBlurFeaturesNV features{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_MOTION_BLUR_FEATURES_NV};
+  vkkit::DeviceOptions options;  // points at `features`
+};
+
+// VK_EXT_opacity_micromap with micromap.
+struct OpacityMicromapDevice {
+  OpacityMicromapDevice();
+  OpacityMicromapDevice(const OpacityMicromapDevice&) = delete;
+  VkPhysicalDeviceOpacityMicromapFeaturesEXT features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_OPACITY_MICROMAP_FEATURES_EXT};
+  vkkit::DeviceOptions options;  // points at `features`
+};
+
+// A bottom-level structure of 64 KiB on a buffer of its own, created with CREATE_MOTION_BIT_NV (and a
+// VkAccelerationStructureMotionInfoNV) or without; destroyed with the object.
+class MotionStructure {
+ public:
+  MotionStructure(vkkit::Device& device, bool motion);
+  ~MotionStructure();
+  MotionStructure(const MotionStructure&) = delete;
+  MotionStructure& operator=(const MotionStructure&) = delete;
+  VkAccelerationStructureKHR handle() const { return handle_; }
+
+ private:
+  vkkit::Device& device_;
+  vkkit::Buffer storage_;
+  VkAccelerationStructureKHR handle_ = VK_NULL_HANDLE;
+};
+
+// An opacity micromap on a buffer of its own, never built (a build reading only special indices does not need its
+// contents); destroyed with the object.
+class Micromap {
+ public:
+  explicit Micromap(vkkit::Device& device);
+  ~Micromap();
+  Micromap(const Micromap&) = delete;
+  Micromap& operator=(const Micromap&) = delete;
+  VkMicromapEXT handle() const { return handle_; }
+
+ private:
+  vkkit::Device& device_;
+  vkkit::Buffer storage_;
+  PFN_vkDestroyMicromapEXT destroy_ = nullptr;
+  VkMicromapEXT handle_ = VK_NULL_HANDLE;
+};
+
+// A buffer whose first 4 bytes hold VK_OPACITY_MICROMAP_SPECIAL_INDEX_FULLY_OPAQUE_EXT as a uint32 (a micromap index a
+// build reads without the micromap's contents).
+vkkit::Buffer SpecialIndexBuffer(vkkit::Device& device);
+
+// A triangle's opacity from `micromap`, by 32-bit special indices read from `indices`, `stride` bytes apart.
+VkAccelerationStructureTrianglesOpacityMicromapEXT OpacityFromSpecialIndices(const vkkit::Buffer& indices,
+                                                                             const Micromap& micromap,
+                                                                             VkDeviceSize stride = 4);
+
+}  // namespace asval_test
