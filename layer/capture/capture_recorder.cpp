@@ -72,10 +72,12 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     if (!NeedsCapture(ctx.mode, info)) continue;
     if (captured.empty()) captured.assign(info_count, 0);
     const VkAccelerationStructureBuildRangeInfoKHR* info_ranges = ranges[i];
-    // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
+    // Motion (VK_NV_ray_tracing_motion_blur): triangles are read at both times; motion instances have other records,
+    // not captured yet.
     const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
-    if (!info_ranges || (!info.pGeometries && !info.ppGeometries) || motion) {
-      counts.NotCaptured(motion ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput);
+    const bool motion_instances = motion && info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    if (!info_ranges || (!info.pGeometries && !info.ppGeometries) || motion_instances) {
+      counts.NotCaptured(motion_instances ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput);
       continue;
     }
     CaptureLog& log = recording.CaptureLogFor(ctx.pool.shared_from_this());
@@ -102,7 +104,7 @@ bool CaptureBuildInputsOrThrow(const CaptureContext& ctx, VkCommandBuffer cb, Co
     CaptureSkip why = CaptureSkip::kNullInput;  // the first reason that stopped the info, once it is not complete
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources, &why);
+      entry.complete = g && PlanCapturedGeometry(*g, info_ranges[j], false, &planned[j], sources, &why, motion);
       first_source.push_back(static_cast<uint32_t>(sources.size()));
     }
     if (!block_tried) {

@@ -11,8 +11,8 @@
 // update's source: their activity record), updates, and every top-level build (its instance references); with
 // `all`, every bottom-level build too. Arrays of instance pointers: the pointers, then the records they point to,
 // gathered by the layer's dispatch where the pool gathers (CaptureGathers; elsewhere the pointers only, the records
-// unknown). Not captured yet (their rules skipped and counted): motion instances, vertex formats the builder does
-// not decode.
+// unknown). Motion builds' triangles are read at both times (capture_plan.h). Not captured yet (their rules skipped and
+// counted): motion instances, vertex formats the builder does not decode.
 #include <vulkan/vulkan.h>
 
 #include <atomic>

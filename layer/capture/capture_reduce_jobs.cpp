@@ -66,8 +66,8 @@ bool Reducible(const CapturedGeometry& g) {
   const uint32_t n = g.range.primitiveCount;
   if (n == 0) return false;
   switch (g.type) {
-    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:  // the shader counts index bytes in 32 bits
-      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 12;
+    case VK_GEOMETRY_TYPE_TRIANGLES_KHR:  // the shader counts index bytes in 32 bits, and reads one vertex set
+      return g.vertex_stride <= UINT32_MAX && n <= UINT32_MAX / 12 && !g.motion;
     case VK_GEOMETRY_TYPE_AABBS_KHR:
       return g.aabb_stride <= UINT32_MAX;
     case VK_GEOMETRY_TYPE_INSTANCES_KHR:

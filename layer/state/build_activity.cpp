@@ -32,6 +32,10 @@ builder::TriangleGeometryView TriangleView(const CaptureLog& log, const Captured
     view.transformData = log.Bytes(g.transform);
     view.transformDataBytes = g.transform.size;
   }
+  if (g.motion_data.present) {  // a motion build: activity and boxes over both times
+    view.motionVertexData = log.Bytes(g.motion_data);
+    view.motionVertexDataBytes = g.motion_data.size;
+  }
   view.range = g.range;
   return view;
 }

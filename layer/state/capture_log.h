@@ -121,6 +121,11 @@ struct CapturedGeometry {
   CapturedBytes data;         // vertices (triangles) or AABB records
   CapturedBytes indices;      // indexed triangles
   CapturedBytes transform;    // triangles with a transform: its 48 bytes (for the warnings only; optional)
+  // Triangles of a motion build (VkAccelerationStructureGeometryMotionTrianglesDataNV::vertexData): the vertices at
+  // time 1, the same range as `data` reads. `motion` is known when the capture is planned (the bytes are present once
+  // copied): such a geometry is copied, never reduced (the layer's dispatch reads one vertex set).
+  bool motion = false;
+  CapturedBytes motion_data;
   // capture_method reduce: `data` holds what the layer's dispatch wrote instead of the bytes (ReducedGeometry);
   // the indices and the transform are still copied.
   bool reduced = false;

@@ -2,6 +2,7 @@
 
 #include "asval/builder/vertex_format.h"
 #include "asval/vertex_formats.h"
+#include "vk_struct_chain.h"
 
 namespace asval {
 
@@ -15,7 +16,7 @@ constexpr VkDeviceSize kTransformBytes = sizeof(VkTransformMatrixKHR);          
 
 bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
                           const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
-                          std::vector<CaptureSource>& sources, CaptureSkip* why) {
+                          std::vector<CaptureSource>& sources, CaptureSkip* why, bool motion) {
   const auto not_captured = [why](CaptureSkip reason) {
     *why = reason;
     return false;
@@ -35,8 +36,16 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
     out->vertex_format = t.vertexFormat;
     out->vertex_stride = t.vertexStride;
     out->index_type = t.indexType;
+    // Motion: the vertices at time 1 come from the same range of another address, in the same format and stride.
+    const VkAccelerationStructureGeometryMotionTrianglesDataNV* at_1 =
+        motion ? FindInChain<VkAccelerationStructureGeometryMotionTrianglesDataNV>(
+                     t.pNext, VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_MOTION_TRIANGLES_DATA_NV)
+               : nullptr;
+    if (motion && !at_1) return not_captured(CaptureSkip::kGeometryNotCaptured);
+    out->motion = at_1 != nullptr;
     if (n == 0) return true;
     if (address(t.vertexData) == 0) return not_captured(CaptureSkip::kNullInput);
+    if (at_1 && address(at_1->vertexData) == 0) return not_captured(CaptureSkip::kNullInput);
     if (address(t.transformData) != 0) {
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.transformData), r.transformOffset), kTransformBytes,
                                       &out->transform, true});
@@ -49,6 +58,9 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
           SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, SaturatingMulBytes(3, n) - 1), format.vertexBytes);
       out->max_vertex = t.maxVertex >= r.firstVertex ? t.maxVertex - r.firstVertex : 0;
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.vertexData), first), bytes, &out->data});
+      if (at_1) {
+        sources.push_back(CaptureSource{SaturatingAddBytes(address(at_1->vertexData), first), bytes, &out->motion_data});
+      }
     } else {
       if (address(t.indexData) == 0) return not_captured(CaptureSkip::kNullInput);
       // Indices from primitiveOffset; vertices index + firstVertex up to maxVertex, from vertexData.
@@ -56,9 +68,10 @@ bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
       out->range.firstVertex = r.firstVertex;
       sources.push_back(CaptureSource{SaturatingAddBytes(address(t.indexData), r.primitiveOffset),
                                       SaturatingMulBytes(SaturatingMulBytes(3, n), index_bytes), &out->indices});
-      sources.push_back(CaptureSource{
-          address(t.vertexData),
-          SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, t.maxVertex), format.vertexBytes), &out->data});
+      const VkDeviceSize vertex_bytes =
+          SaturatingAddBytes(SaturatingMulBytes(t.vertexStride, t.maxVertex), format.vertexBytes);
+      sources.push_back(CaptureSource{address(t.vertexData), vertex_bytes, &out->data});
+      if (at_1) sources.push_back(CaptureSource{address(at_1->vertexData), vertex_bytes, &out->motion_data});
     }
     return true;
   }

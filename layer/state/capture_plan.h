@@ -40,9 +40,11 @@ struct CaptureSource {
 // The ranges geometry g reads into `sources` (appended), its captured parameters into *out. `host`: the
 // geometry's addresses are host pointers (vkBuildAccelerationStructuresKHR). False when the geometry is not
 // captured, and *why says why: a kind or format the builder does not read (kGeometryNotCaptured), a null address
-// with primitives to read (kNullInput).
+// with primitives to read (kNullInput). `motion`: the build sets VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV, so a
+// triangles geometry's VkAccelerationStructureGeometryMotionTrianglesDataNV (its vertices at time 1) is read too; a
+// motion build's triangles without one are not captured (kGeometryNotCaptured).
 bool PlanCapturedGeometry(const VkAccelerationStructureGeometryKHR& g,
                           const VkAccelerationStructureBuildRangeInfoKHR& r, bool host, CapturedGeometry* out,
-                          std::vector<CaptureSource>& sources, CaptureSkip* why);
+                          std::vector<CaptureSource>& sources, CaptureSkip* why, bool motion = false);
 
 }  // namespace asval
