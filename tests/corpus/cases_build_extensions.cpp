@@ -78,3 +78,28 @@ CORPUS_CASE_ON_TEST_DRIVER(MicromapValid, "micromap-special-indices", "structure
 }
 
 }  // namespace
+
+namespace {
+
+using asval_test::MotionRefit;
+
+CORPUS_CASE_ON_TEST_DRIVER(MotionRefitDeactivates, "motion-refit-makes-triangle-inactive-at-time-1", "history", kMotion,
+                           "a motion refit whose vertices at time 1 give a triangle a NaN X, which makes it inactive",
+                           {"VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-03664"}) {
+  MotionRefit refit(device);
+  refit.Run(false);
+  refit.NanAtTime1(1);
+  refit.Run(true);
+}
+
+CORPUS_CASE_ON_TEST_DRIVER(MotionRefitMoves, "motion-refit-moves-vertices-at-time-1", "history", kMotion,
+                           "motion refits that move the vertices at time 1 frame after frame", {}) {
+  MotionRefit refit(device);
+  refit.Run(false);
+  for (float dx : {0.5f, 1.0f, 2.0f}) {
+    MotionRefit::Write(refit.at_1(), dx);
+    refit.Run(true);
+  }
+}
+
+}  // namespace

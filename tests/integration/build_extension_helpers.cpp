@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "history_helpers.h"
+
 namespace asval_test {
 
 MotionBlurDevice::MotionBlurDevice() {
@@ -33,6 +35,70 @@ MotionStructure::MotionStructure(vkkit::Device& device, bool motion) : device_(d
 MotionStructure::~MotionStructure() {
   device_.DestroyAccelerationStructureKHR(device_.handle(), handle_, nullptr);
   device_.Destroy(storage_);
+}
+
+MotionRefit::MotionRefit(vkkit::Device& device, bool motion)
+    : device_(device), motion_(motion), structure_(device, motion) {
+  for (vkkit::Buffer* b : {&at_0_, &at_1_}) {
+    *b = device.CreateBuffer(256, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  }
+  scratch_ = device.CreateBuffer(1 << 20, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Write(at_0_, 0.0f);
+  Write(at_1_, 0.0f);
+}
+
+MotionRefit::~MotionRefit() {
+  for (vkkit::Buffer* b : {&at_0_, &at_1_, &scratch_}) device_.Destroy(*b);
+}
+
+void MotionRefit::Write(vkkit::Buffer& buffer, float dx) {
+  float v[18];
+  const float corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  for (int k = 0; k < 6; ++k) {
+    v[3 * k + 0] = corner[k % 3][0] + dx;
+    v[3 * k + 1] = corner[k % 3][1];
+    v[3 * k + 2] = static_cast<float>(k / 3);
+  }
+  std::memcpy(buffer.mapped, v, sizeof(v));
+}
+
+void MotionRefit::NanAtTime1(uint32_t t) {
+  const uint32_t nan = 0x7fc00000u;
+  std::memcpy(static_cast<char*>(at_1_.mapped) + 36 * t, &nan, sizeof(nan));
+}
+
+VkResult MotionRefit::Run(bool update) {
+  VkAccelerationStructureGeometryMotionTrianglesDataNV time_1{
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_MOTION_TRIANGLES_DATA_NV};
+  time_1.vertexData.deviceAddress = at_1_.address;
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  VkAccelerationStructureGeometryTrianglesDataKHR& t = geometry.geometry.triangles;
+  t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  t.pNext = &time_1;  // chained either way: read only by a motion build
+  t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  t.vertexData.deviceAddress = at_0_.address;
+  t.vertexStride = 12;
+  t.maxVertex = 5;
+  t.indexType = VK_INDEX_TYPE_NONE_KHR;
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR |
+               (motion_ ? VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV : 0);
+  info.mode = update ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.srcAccelerationStructure = update ? structure_.handle() : VK_NULL_HANDLE;
+  info.dstAccelerationStructure = structure_.handle();
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  info.scratchData.deviceAddress = scratch_.address;
+  const VkAccelerationStructureBuildRangeInfoKHR range{2, 0, 0, 0};
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+  Commands commands(device_);
+  VkCommandBuffer cb = commands.Begin();
+  device_.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
+  commands.End(cb);
+  return commands.Submit(cb);
 }
 
 Micromap::Micromap(vkkit::Device& device) : device_(device) {

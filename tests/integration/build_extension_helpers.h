@@ -41,6 +41,33 @@ class MotionStructure {
   VkAccelerationStructureKHR handle_ = VK_NULL_HANDLE;
 };
 
+// Two triangles of a motion build: their vertices at time 0 and at time 1 in host-visible buffers of their own, a
+// structure created for motion (or not: `motion` false builds without the flag, its geometry still chaining the time-1
+// vertices), scratch; builds and updates in place, each submitted alone and waited for (the capture's findings are
+// reported in the wait).
+class MotionRefit {
+ public:
+  explicit MotionRefit(vkkit::Device& device, bool motion = true);
+  ~MotionRefit();
+  MotionRefit(const MotionRefit&) = delete;
+  MotionRefit& operator=(const MotionRefit&) = delete;
+
+  // Six vertices (two unit right triangles) moved by dx along X, into `buffer`.
+  static void Write(vkkit::Buffer& buffer, float dx);
+  // Triangle t's first vertex X at time 1 made NaN: with motion, the triangle is inactive (an X of any of its six
+  // vertices).
+  void NanAtTime1(uint32_t t);
+  vkkit::Buffer& at_1() { return at_1_; }
+  // A build, or an update in place, of both triangles, submitted and waited for: the layer's result.
+  VkResult Run(bool update);
+
+ private:
+  vkkit::Device& device_;
+  bool motion_;
+  MotionStructure structure_;
+  vkkit::Buffer at_0_, at_1_, scratch_;
+};
+
 // An opacity micromap on a buffer of its own, never built (a build reading only special indices does not need its
 // contents); destroyed with the object.
 class Micromap {
