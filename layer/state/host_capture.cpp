@@ -49,13 +49,15 @@ HostCapture CaptureOrThrow(uint32_t info_count, const VkAccelerationStructureBui
     entry.element = i;
     planned.assign(info.geometryCount, CapturedGeometry{});
     sources.clear();
-    // Motion instances (VK_NV_ray_tracing_motion_blur) have other records: not captured yet.
+    // Motion (VK_NV_ray_tracing_motion_blur): triangles are read at both times; motion instances have other records,
+    // not captured yet.
     const bool motion = (info.flags & VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV) != 0;
-    CaptureSkip why = motion ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput;  // once not complete
-    entry.complete = ranges[i] && (info.pGeometries || info.ppGeometries) && !motion;
+    const bool motion_instances = motion && info.type != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    CaptureSkip why = motion_instances ? CaptureSkip::kGeometryNotCaptured : CaptureSkip::kNullInput;
+    entry.complete = ranges[i] && (info.pGeometries || info.ppGeometries) && !motion_instances;
     for (uint32_t j = 0; j < info.geometryCount && entry.complete; ++j) {
       const VkAccelerationStructureGeometryKHR* g = info.pGeometries ? &info.pGeometries[j] : info.ppGeometries[j];
-      entry.complete = g && PlanCapturedGeometry(*g, ranges[i][j], true, &planned[j], sources, &why);
+      entry.complete = g && PlanCapturedGeometry(*g, ranges[i][j], true, &planned[j], sources, &why, motion);
     }
     VkDeviceSize total = 0;
     for (const CaptureSource& s : sources) total = SaturatingAddBytes(total, s.size);

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "history_helpers.h"
+#include "memory_placement_helpers.h"
 
 namespace asval_test {
 
@@ -67,22 +68,31 @@ void MotionRefit::NanAtTime1(uint32_t t) {
   std::memcpy(static_cast<char*>(at_1_.mapped) + 36 * t, &nan, sizeof(nan));
 }
 
-VkResult MotionRefit::Run(bool update) {
-  VkAccelerationStructureGeometryMotionTrianglesDataNV time_1{
+VkAccelerationStructureBuildGeometryInfoKHR MotionRefit::Info(
+    bool update, bool host, VkAccelerationStructureGeometryMotionTrianglesDataNV& time_1,
+    VkAccelerationStructureGeometryKHR& geometry) {
+  time_1 = VkAccelerationStructureGeometryMotionTrianglesDataNV{
       VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_MOTION_TRIANGLES_DATA_NV};
-  time_1.vertexData.deviceAddress = at_1_.address;
-  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry = VkAccelerationStructureGeometryKHR{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
   geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
   geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
   VkAccelerationStructureGeometryTrianglesDataKHR& t = geometry.geometry.triangles;
   t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
   t.pNext = &time_1;  // chained either way: read only by a motion build
   t.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-  t.vertexData.deviceAddress = at_0_.address;
   t.vertexStride = 12;
   t.maxVertex = 5;
   t.indexType = VK_INDEX_TYPE_NONE_KHR;
   VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  if (host) {
+    time_1.vertexData.hostAddress = at_1_.mapped;
+    t.vertexData.hostAddress = at_0_.mapped;
+    info.scratchData.hostAddress = host_scratch_.data();
+  } else {
+    time_1.vertexData.deviceAddress = at_1_.address;
+    t.vertexData.deviceAddress = at_0_.address;
+    info.scratchData.deviceAddress = scratch_.address;
+  }
   info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
   info.flags = VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR |
                (motion_ ? VK_BUILD_ACCELERATION_STRUCTURE_MOTION_BIT_NV : 0);
@@ -91,7 +101,13 @@ VkResult MotionRefit::Run(bool update) {
   info.dstAccelerationStructure = structure_.handle();
   info.geometryCount = 1;
   info.pGeometries = &geometry;
-  info.scratchData.deviceAddress = scratch_.address;
+  return info;
+}
+
+VkResult MotionRefit::Run(bool update) {
+  VkAccelerationStructureGeometryMotionTrianglesDataNV time_1;
+  VkAccelerationStructureGeometryKHR geometry;
+  const VkAccelerationStructureBuildGeometryInfoKHR info = Info(update, false, time_1, geometry);
   const VkAccelerationStructureBuildRangeInfoKHR range{2, 0, 0, 0};
   const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
   Commands commands(device_);
@@ -99,6 +115,14 @@ VkResult MotionRefit::Run(bool update) {
   device_.CmdBuildAccelerationStructuresKHR(cb, 1, &info, &ranges);
   commands.End(cb);
   return commands.Submit(cb);
+}
+
+VkResult MotionRefit::RunOnHost(bool update) {
+  VkAccelerationStructureGeometryMotionTrianglesDataNV time_1;
+  VkAccelerationStructureGeometryKHR geometry;
+  const VkAccelerationStructureBuildGeometryInfoKHR info = Info(update, true, time_1, geometry);
+  const VkAccelerationStructureBuildRangeInfoKHR range{2, 0, 0, 0};
+  return CallHostBuild(device_, {info}, {&range});
 }
 
 Micromap::Micromap(vkkit::Device& device) : device_(device) {

@@ -4,6 +4,8 @@
 // micromaps (VK_EXT_opacity_micromap), and the device options that enable them.
 #include <vulkan/vulkan.h>
 
+#include <vector>
+
 #include "vkkit.h"
 
 namespace asval_test {
@@ -60,12 +62,21 @@ class MotionRefit {
   vkkit::Buffer& at_1() { return at_1_; }
   // A build, or an update in place, of both triangles, submitted and waited for: the layer's result.
   VkResult Run(bool update);
+  // The same as a host build (vkBuildAccelerationStructuresKHR, host pointers to the same vertices; the device
+  // enables accelerationStructureHostCommands).
+  VkResult RunOnHost(bool update);
 
  private:
   vkkit::Device& device_;
   bool motion_;
   MotionStructure structure_;
   vkkit::Buffer at_0_, at_1_, scratch_;
+  std::vector<unsigned char> host_scratch_ = std::vector<unsigned char>(1 << 20);
+
+  // The build's info over `time_1` and `geometry` (which it points to), with device or host addresses.
+  VkAccelerationStructureBuildGeometryInfoKHR Info(bool update, bool host,
+                                                   VkAccelerationStructureGeometryMotionTrianglesDataNV& time_1,
+                                                   VkAccelerationStructureGeometryKHR& geometry);
 };
 
 // An opacity micromap on a buffer of its own, never built (a build reading only special indices does not need its

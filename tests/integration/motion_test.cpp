@@ -123,3 +123,45 @@ TEST_CASE(
 
 }  // namespace
 }  // namespace asval_test
+
+namespace asval_test {
+namespace {
+
+// The motion device with accelerationStructureHostCommands (the test driver executes host builds).
+struct HostMotionDevice {
+  HostMotionDevice() { base.options.host_commands = true; }
+  MotionBlurDevice base;
+  const vkkit::DeviceOptions& options() const { return base.options; }
+};
+
+TEST_CASE(
+    "motion capture: a host motion refit whose vertices at time 1 make an active triangle inactive is reported "
+    "when called (vkBuildAccelerationStructuresKHR-pInfos-03664)",
+    "[integration][capture][host][motion][test-driver][newer-input]") {
+  const OnTestDriver driver;
+  const HostMotionDevice motion_device;
+  HistoryFixture f(nullptr, {}, motion_device.options());
+  MotionRefit refit(f.device());
+  REQUIRE(refit.RunOnHost(false) == VK_SUCCESS);
+  refit.NanAtTime1(1);
+  f.monitor().Expect("VUID-vkBuildAccelerationStructuresKHR-pInfos-03664");
+  CHECK(refit.RunOnHost(true) == VK_ERROR_VALIDATION_FAILED_EXT);
+  CHECK(f.monitor().Verify() == "");
+}
+
+TEST_CASE("motion capture valid twin: host motion refits that move the vertices at time 1 stay silent and execute",
+          "[integration][capture][host][motion][test-driver][valid][newer-input]") {
+  const OnTestDriver driver;
+  const HostMotionDevice motion_device;
+  HistoryFixture f(nullptr, {}, motion_device.options());
+  MotionRefit refit(f.device());
+  REQUIRE(refit.RunOnHost(false) == VK_SUCCESS);
+  for (float dx : {0.5f, 1.0f, 2.0f}) {
+    MotionRefit::Write(refit.at_1(), dx);
+    CHECK(refit.RunOnHost(true) == VK_SUCCESS);
+  }
+  CHECK(f.monitor().Verify() == "");
+}
+
+}  // namespace
+}  // namespace asval_test
